@@ -58,7 +58,23 @@ _EXPORTS = {
     "add_noise": "noise",
 }
 
-__all__ = sorted(["MeshError", "MeshWarning", *_EXPORTS])
+__all__ = sorted(["MeshError", "MeshWarning", "data_path", *_EXPORTS])
+
+
+def data_path(name=""):
+    """Path of a mesh the workbook ships (``meshes/NAME`` in the repository).
+
+    ``data_path()`` is the folder itself. Raises MeshError naming the file and
+    listing what is there when the mesh does not exist.
+    """
+    from pathlib import Path
+
+    folder = Path(__file__).resolve().parent.parent / "meshes"
+    path = folder / name
+    if name and not path.exists():
+        have = sorted(p.name for p in folder.glob("*") if p.suffix in (".obj", ".off", ".ply", ".stl"))
+        raise MeshError(f"no shipped mesh named {name!r} in meshes/; available: {', '.join(have) or 'none'}")
+    return path
 
 
 def __getattr__(name):
