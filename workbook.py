@@ -68,7 +68,8 @@ def main(argv):
         return 2
     command, rest = argv[0], argv[1:]
     ensure_environment()
-    env = dict(os.environ, PYTHONNOUSERSITE="1")
+    # the kernel and packages of .venv win over any in the user's home folder
+    env = dict(os.environ, PYTHONNOUSERSITE="1", JUPYTER_PREFER_ENV_PATH="1")
     if command == "setup":
         return 0
     if command == "lab":
