@@ -39,6 +39,7 @@ _EXPORTS = {
     "valence": "topology",
     "one_ring": "topology",
     "euler_characteristic": "topology",
+    "connected_components": "topology",
     # Laplacians and curvature
     "laplacian": "laplace",
     "cotangent_weights": "laplace",

@@ -1,0 +1,596 @@
+"""Reading and writing triangle meshes: OBJ, OFF, PLY, STL.
+
+Convention: :func:`load_mesh` returns ``V`` as (n, 3) float64 and ``F`` as
+(m, 3) int64 with 0-based indices, and the vertices are exactly the file's
+vertices in the file's order: nothing is merged, dropped, split or reordered.
+(General-purpose loaders often merge duplicate positions, drop unreferenced
+vertices or split vertices along texture seams; the workbook's results are
+per-vertex arrays that must line up with the file.)
+
+Format notes
+------------
+OBJ (read by this module's own parser)
+    ``v x y z`` (an optional ``w`` or ``r g b`` after the coordinates is
+    ignored); faces ``f v``, ``f v/vt``, ``f v//vn``, ``f v/vt/vn`` with
+    1-based or negative (relative: -1 is the latest vertex defined above the
+    face) indices. Only the vertex index of each corner is used: ``vn`` and
+    ``vt`` lines are skipped without being read, so normals and texture
+    coordinates never split a vertex. A polygon with k > 3 corners
+    ``(p0, p1, ..., pk-1)`` is triangulated as the fan
+    ``(p0, p1, p2), (p0, p2, p3), ..., (p0, pk-2, pk-1)``, which keeps the
+    polygon's orientation (exact for convex planar polygons). Comments (``#``),
+    blank lines and the statements ``o g s usemtl mtllib l p vp`` and the
+    free-form geometry statements are ignored; a line continued with a
+    trailing backslash is joined to the next. Any other line is an error
+    naming its line number.
+OFF (own parser)
+    Optional ``OFF``/``COFF``/``NOFF``/``CNOFF`` header (counts on the same or
+    the next line), ``#`` comments, vertex lines (extra numbers after x y z
+    such as colours ignored), face lines ``k i0 ... ik-1`` with 0-based
+    indices (extra numbers after them ignored), polygons fan-triangulated as
+    for OBJ. Binary OFF is not supported.
+PLY (read with trimesh, ``process=False, maintain_order=True``)
+    Vertex order and count as in the file; polygons are triangulated by trimesh.
+STL (read with trimesh, ``process=False``)
+    STL has no shared vertices: each facet stores its own three corners. The
+    corners are kept as they are, three vertices per facet in file order
+    (facet f is ``(3f, 3f+1, 3f+2)``); nothing is merged. :func:`check_mesh`
+    therefore reports m components and every edge on the boundary. Merge
+    coincident vertices yourself (e.g. ``trimesh.Trimesh(V, F).merge_vertices()``)
+    if you want a connected surface.
+
+Errors
+------
+Bad files raise :class:`~geomlib.MeshError` whose message starts with the
+path and names the problem: missing or unreadable file, unknown extension,
+empty file, vertices without faces, a malformed line (its line number),
+NaN/infinite coordinates (the vertices), face indices out of range (the
+faces, their lines for OBJ/OFF, the bad index and the vertex count), faces
+repeating a vertex (the faces and lines). Properties that do not stop a
+computation (zero-area faces, non-manifold parts, several components,
+unreferenced vertices, ...) are summarised in one :class:`~geomlib.MeshWarning`
+(see :func:`geomlib.validate.check_mesh`); the mesh is returned unaltered.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .errors import MeshError, MeshWarning, format_indices
+from .validate import as_mesh, as_vertices, check_mesh
+
+__all__ = ["load_mesh", "save_mesh", "SUPPORTED_EXTENSIONS"]
+
+SUPPORTED_EXTENSIONS = (".obj", ".off", ".ply", ".stl")
+
+# statements of the OBJ format that carry nothing for a triangle mesh
+_OBJ_IGNORED = {
+    b"vn", b"vt", b"vp", b"o", b"g", b"s", b"usemtl", b"mtllib", b"l", b"p", b"mg",
+    b"cstype", b"deg", b"bmat", b"step", b"curv", b"curv2", b"surf", b"parm", b"trim", b"hole",
+    b"scrv", b"sp", b"end", b"con", b"bevel", b"c_interp", b"d_interp", b"lod", b"maplib",
+    b"usemap", b"shadow_obj", b"trace_obj", b"ctech", b"stech",
+}
+
+
+class _Fallback(Exception):
+    """The vectorised OBJ reader met something unusual; reread line by line."""
+
+
+def _show(line, limit=60):
+    text = line.decode("utf-8", "replace").strip()
+    return repr(text if len(text) <= limit else text[:limit] + "...")
+
+
+# --------------------------------------------------------------------------
+# OBJ, vectorised path
+
+
+def _select_lines(data, arr, starts, ends, idx):
+    """Bytes of the lines ``idx`` (each with its newline), concatenated."""
+    if len(idx) == 0:
+        return b""
+    breaks = np.flatnonzero(np.diff(idx) != 1)
+    if len(breaks) < 64:  # a few contiguous blocks: plain slices
+        first = np.r_[idx[0], idx[breaks + 1]]
+        last = np.r_[idx[breaks], idx[-1]]
+        return b"".join(data[s:e + 1] for s, e in zip(starts[first].tolist(), ends[last].tolist()))
+    # many interleaved lines (e.g. v / vn alternating): mask of the bytes to keep
+    mark = np.zeros(len(arr) + 1, np.int8)
+    mark[starts[idx]] = 1
+    mark[ends[idx] + 1] -= 1
+    keep = np.cumsum(mark[:-1], dtype=np.int8).view(bool)
+    return arr[keep].tobytes()
+
+
+def _tokens_per_line(buf):
+    """Whitespace-separated tokens on each newline-terminated line of ``buf``."""
+    s = np.frombuffer(buf, np.uint8)
+    ws = s <= 32  # space, tab, CR, LF and other control bytes
+    tok = np.flatnonzero(~ws[1:] & ws[:-1]) + 1
+    if len(s) and not ws[0]:
+        tok = np.r_[0, tok]
+    nl = np.flatnonzero(s == 10)
+    return np.diff(np.searchsorted(tok, nl), prepend=0)
+
+
+def _fromstring(buf, dtype):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        try:
+            return np.fromstring(buf, sep=" ", dtype=dtype)
+        except (ValueError, DeprecationWarning):
+            raise _Fallback from None
+
+
+def _obj_fast(data):
+    if b"\\" in data:
+        raise _Fallback
+    arr = np.frombuffer(data, np.uint8)
+    nl = np.flatnonzero(arr == 10)
+    starts = np.empty(len(nl), np.int64)
+    starts[:1] = 0
+    starts[1:] = nl[:-1] + 1
+    ends = nl
+    last = len(arr) - 1
+    c0 = arr[starts]
+    c1 = arr[np.minimum(starts + 1, last)]
+    c2 = arr[np.minimum(starts + 2, last)]
+    ws1 = (c1 == 32) | (c1 == 9)
+    ws2 = (c2 == 32) | (c2 == 9)
+    is_v = (c0 == ord("v")) & ws1
+    is_f = (c0 == ord("f")) & ws1
+    known = (
+        is_v | is_f | (c0 == ord("#")) | (c0 == 10) | ((c0 == 13) & (c1 == 10))
+        | ((c0 == ord("v")) & ((c1 == ord("n")) | (c1 == ord("t")) | (c1 == ord("p"))) & ws2)
+        | (np.isin(c0, np.frombuffer(b"ogslp", np.uint8)) & (ws1 | (c1 == 10) | (c1 == 13)))
+    )
+    for k in np.flatnonzero(~known).tolist():
+        words = data[starts[k]:ends[k]].split()
+        if not words or words[0] in _OBJ_IGNORED or words[0].startswith(b"#"):
+            continue
+        raise _Fallback  # indented v/f, unknown statements, bad bytes: the slow reader decides
+    v_idx = np.flatnonzero(is_v)
+    f_idx = np.flatnonzero(is_f)
+
+    vbuf = _select_lines(data, arr, starts, ends, v_idx).replace(b"v", b" ")
+    counts = _tokens_per_line(vbuf)
+    vals = _fromstring(vbuf, np.float64)
+    if len(vals) != counts.sum():
+        raise _Fallback
+    if len(counts) and (counts == 3).all():
+        V = vals.reshape(-1, 3)
+    else:
+        if len(counts) and not np.isin(counts, (3, 4, 6, 7)).all():
+            raise _Fallback
+        offs = np.cumsum(counts) - counts
+        V = vals[offs[:, None] + np.arange(3)]
+
+    fbuf = _select_lines(data, arr, starts, ends, f_idx).replace(b"f", b" ")
+    if b"/" in fbuf:
+        fbuf = re.sub(rb"/\S*", b"", fbuf)
+    sizes = _tokens_per_line(fbuf)
+    idx = _fromstring(fbuf, np.int64)
+    if len(idx) != sizes.sum():
+        raise _Fallback
+    lines = f_idx + 1
+    vbefore = None
+    if len(idx) and idx.min() < 0:
+        vbefore = np.searchsorted(v_idx, f_idx)  # v lines above each face line
+    return V, idx, sizes, lines, vbefore
+
+
+# --------------------------------------------------------------------------
+# OBJ, line by line (odd files, and exact error locations)
+
+
+def _obj_slow(data, where):
+    verts, idx, sizes, lines, vbefore = [], [], [], [], []
+    pending = b""
+    pending_line = 0
+    for lineno, raw in enumerate(data.split(b"\n"), start=1):
+        if pending:
+            raw = pending + b" " + raw
+            lineno = pending_line
+            pending = b""
+        stripped = raw.rstrip()
+        if stripped.endswith(b"\\"):
+            pending, pending_line = stripped[:-1], lineno
+            continue
+        hash_pos = stripped.find(b"#")
+        if hash_pos >= 0:
+            stripped = stripped[:hash_pos]
+        words = stripped.split()
+        if not words:
+            continue
+        key = words[0]
+        if key == b"v":
+            if len(words) - 1 not in (3, 4, 6, 7):
+                raise MeshError(
+                    f"{where}: line {lineno}: a vertex needs x y z (optionally w or r g b), "
+                    f"found {len(words) - 1} numbers: {_show(raw)}"
+                )
+            try:
+                verts.append([float(w) for w in words[1:4]])
+                [float(w) for w in words[4:]]
+            except ValueError:
+                raise MeshError(f"{where}: line {lineno}: vertex coordinates are not numbers: {_show(raw)}") from None
+        elif key == b"f":
+            corners = words[1:]
+            try:
+                face = []
+                for c in corners:
+                    head = c.split(b"/")[0]
+                    face.append(int(head))
+            except ValueError:
+                raise MeshError(
+                    f"{where}: line {lineno}: face corners must be integers (v, v/vt, v//vn or v/vt/vn): {_show(raw)}"
+                ) from None
+            idx.extend(face)
+            sizes.append(len(face))
+            lines.append(lineno)
+            vbefore.append(len(verts))
+        elif key in _OBJ_IGNORED:
+            continue
+        else:
+            raise MeshError(
+                f"{where}: line {lineno}: not an OBJ statement (expected v, f, vn, vt, o, g, s, usemtl, "
+                f"mtllib or a # comment): {_show(raw)}"
+            )
+    V = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
+    return (V, np.asarray(idx, np.int64), np.asarray(sizes, np.int64),
+            np.asarray(lines, np.int64), np.asarray(vbefore, np.int64))
+
+
+# --------------------------------------------------------------------------
+# polygons -> triangles, with file-level checks
+
+
+def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None, line_word="line"):
+    """Resolve file indices, check them with line numbers, fan-triangulate.
+
+    ``idx`` holds the corner indices as written; ``sizes`` the corners per
+    polygon; ``lines`` the line number of each polygon.
+    """
+    if len(sizes) == 0:
+        return np.zeros((0, 3), np.int64)
+    small = np.flatnonzero(sizes < 3)
+    if len(small):
+        p = small[0]
+        raise MeshError(
+            f"{where}: {line_word} {lines[p]}: a face needs at least 3 vertex indices, found {sizes[p]}"
+            + (f" (and {len(small) - 1} more such faces, lines {format_indices(lines[small[1:]])})" if len(small) > 1 else "")
+        )
+    poly = np.repeat(np.arange(len(sizes)), sizes)
+    if one_based:
+        zero = np.flatnonzero(idx == 0)
+        if len(zero):
+            raise MeshError(
+                f"{where}: {line_word} {lines[poly[zero[0]]]}: vertex index 0 is invalid (OBJ indices start at 1; "
+                f"lines {format_indices(np.unique(lines[poly[zero]]))})"
+            )
+        res = idx - 1
+        neg = idx < 0
+        if neg.any():
+            res = np.where(neg, vbefore[poly] + idx, res)
+    else:
+        res = idx
+    bad = (res < 0) | (res >= n)
+    if bad.any():
+        corners = np.flatnonzero(bad)
+        bad_polys = np.unique(poly[corners])
+        detail = "; ".join(
+            f"{line_word} {lines[poly[c]]}: index {idx[c]}" for c in corners[:5]
+        )
+        raise MeshError(
+            f"{where}: face indices out of range, the file has {n} vertices "
+            f"({'1..' + str(n) + ' or -1..-' + str(n) if one_based else '0..' + str(n - 1)} are valid): "
+            f"{detail}" + (f" (and {len(corners) - 5} more)" if len(corners) > 5 else "")
+            + f"; {len(bad_polys)} faces on {line_word}s {format_indices(lines[bad_polys])}"
+        )
+    if (sizes == 3).all():
+        F = res.reshape(-1, 3)
+        tri_poly = None
+    else:
+        ntri = sizes - 2
+        tri_poly = np.repeat(np.arange(len(sizes)), ntri)
+        j = np.arange(int(ntri.sum())) - np.repeat(np.cumsum(ntri) - ntri, ntri) + 1
+        o = (np.cumsum(sizes) - sizes)[tri_poly]
+        F = np.stack([res[o], res[o + j], res[o + j + 1]], axis=1)
+    rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
+    if rep.any():
+        rows = np.flatnonzero(rep)
+        plines = lines[rows if tri_poly is None else tri_poly[rows]]
+        detail = "; ".join(f"{line_word} {L}: face {r} = {F[r].tolist()}" for r, L in zip(rows[:5], plines[:5]))
+        raise MeshError(
+            f"{where}: {len(rows)} face(s) repeat a vertex (no triangle; 0-based indices): {detail}"
+            + f"; faces {format_indices(rows)} on {line_word}s {format_indices(np.unique(plines))}"
+        )
+    return np.ascontiguousarray(F, dtype=np.int64)
+
+
+def _read_obj(data, where):
+    if b"\n" not in data and b"\r" in data:  # classic Mac line ends
+        data = data.replace(b"\r", b"\n")
+    if not data.endswith(b"\n"):
+        data += b"\n"
+    try:
+        V, idx, sizes, lines, vbefore = _obj_fast(data)
+    except _Fallback:
+        V, idx, sizes, lines, vbefore = _obj_slow(data, where)
+    else:
+        if len(V) == 0 and len(sizes) == 0:
+            # nothing recognised: let the line-by-line reader say what is there
+            V, idx, sizes, lines, vbefore = _obj_slow(data, where)
+    _no_mesh_check(where, len(V), len(sizes))
+    V = _check_vertices(V, where, lines_of=None)
+    F = _build_faces(where, len(V), idx, sizes, lines, one_based=True, vbefore=vbefore)
+    return V, F
+
+
+def _no_mesh_check(where, nv, nf):
+    if nv == 0 and nf == 0:
+        raise MeshError(f"{where}: the file holds no vertices and no faces")
+    if nv == 0:
+        raise MeshError(f"{where}: the file has {nf} faces but no vertices")
+    if nf == 0:
+        raise MeshError(
+            f"{where}: the file has {nv} vertices but no faces (a point cloud or polyline is not a triangle mesh)"
+        )
+
+
+def _check_vertices(V, where, lines_of=None):
+    if not np.isfinite(V).all():
+        bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
+        at = f" (lines {format_indices(lines_of[bad])})" if lines_of is not None else ""
+        raise MeshError(
+            f"{where}: {len(bad)} vertices have NaN or infinite coordinates: vertices {format_indices(bad)} "
+            f"(0-based){at}"
+        )
+    return as_vertices(V, where=where)
+
+
+# --------------------------------------------------------------------------
+# OFF
+
+
+def _read_off(data, where):
+    content = []  # (line number, words) of lines with content
+    for lineno, raw in enumerate(data.split(b"\n"), start=1):
+        hash_pos = raw.find(b"#")
+        if hash_pos >= 0:
+            raw = raw[:hash_pos]
+        words = raw.split()
+        if words:
+            content.append((lineno, words))
+    if not content:
+        raise MeshError(f"{where}: the file holds no vertices and no faces")
+    pos = 0
+    lineno, words = content[0]
+    head = words[0].upper()
+    if head.endswith(b"OFF"):
+        if len(words) > 1 and words[1].upper() == b"BINARY":
+            raise MeshError(f"{where}: line {lineno}: binary OFF is not supported; save it as ASCII OFF, OBJ or PLY")
+        words = words[1:]
+        if not words:
+            pos = 1
+            if len(content) < 2:
+                raise MeshError(f"{where}: line {lineno}: OFF header without the counts line 'nv nf ne'")
+            lineno, words = content[1]
+    try:
+        nv, nf = int(words[0]), int(words[1])
+        if nv < 0 or nf < 0:
+            raise ValueError
+    except (ValueError, IndexError):
+        raise MeshError(f"{where}: line {lineno}: expected the counts 'nv nf ne' of the OFF header, "
+                        f"found {_show(b' '.join(words))}") from None
+    pos += 1
+    vlines = content[pos:pos + nv]
+    flines = content[pos + nv:pos + nv + nf]
+    if len(vlines) < nv or len(flines) < nf:
+        raise MeshError(
+            f"{where}: the header (line {lineno}) announces {nv} vertices and {nf} faces, but the file ends "
+            f"after {len(vlines)} vertex lines and {len(flines)} face lines"
+        )
+    _no_mesh_check(where, nv, nf)
+    V = np.empty((nv, 3))
+    for k, (ln, w) in enumerate(vlines):
+        try:
+            if len(w) < 3:
+                raise ValueError
+            V[k] = [float(x) for x in w[:3]]
+        except ValueError:
+            raise MeshError(f"{where}: line {ln}: a vertex needs 3 numbers x y z, found {_show(b' '.join(w))}") from None
+    idx, sizes, lines = [], [], []
+    for ln, w in flines:
+        try:
+            k = int(w[0])
+            if k < 0 or len(w) < 1 + k:
+                raise ValueError
+            idx.extend(int(x) for x in w[1:1 + k])
+        except ValueError:
+            raise MeshError(f"{where}: line {ln}: a face is 'k i0 ... ik-1' with k integer indices, "
+                            f"found {_show(b' '.join(w))}") from None
+        sizes.append(k)
+        lines.append(ln)
+    vline_numbers = np.asarray([ln for ln, _ in vlines])
+    V = _check_vertices(V, where, lines_of=vline_numbers)
+    F = _build_faces(where, nv, np.asarray(idx, np.int64), np.asarray(sizes, np.int64),
+                     np.asarray(lines, np.int64), one_based=False)
+    return V, F
+
+
+# --------------------------------------------------------------------------
+# PLY and STL through trimesh
+
+
+def _read_trimesh(path, where, ext):
+    import trimesh
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            loaded = trimesh.load(str(path), file_type=ext[1:], process=False, maintain_order=True)
+    except Exception as exc:  # any parser failure becomes a MeshError naming the file
+        raise MeshError(f"{where}: cannot read as {ext[1:].upper()}: {type(exc).__name__}: {exc}") from None
+    if isinstance(loaded, trimesh.Scene):
+        geoms = list(loaded.geometry.values())
+        if len(geoms) != 1:
+            raise MeshError(f"{where}: the file holds {len(geoms)} objects; save one mesh per file")
+        loaded = geoms[0]
+    V = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    F = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))))
+    if F.size == 0:
+        F = np.zeros((0, 3), np.int64)
+    _no_mesh_check(where, len(V), len(F))
+    V = _check_vertices(V, where)
+    _, F = as_mesh(V, F, where=where)
+    return V, F
+
+
+# --------------------------------------------------------------------------
+# public
+
+
+def load_mesh(path, report=False):
+    """Read a triangle mesh from an OBJ, OFF, PLY or STL file, exactly as stored.
+
+    Returns the file's vertices in the file's order (nothing merged, dropped
+    or reordered) and its faces, polygons fan-triangulated; see the module
+    docstring for each format.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        File name; the format is chosen by the extension (case-insensitive).
+    report : bool
+        False (default): if :func:`~geomlib.check_mesh` finds problems (zero-area
+        faces, non-manifold edges or vertices, inconsistent orientation,
+        several components, unreferenced vertices, duplicate faces), emit ONE
+        :class:`~geomlib.MeshWarning` summarising them. True: emit nothing and
+        return the :class:`~geomlib.MeshReport` as a third value.
+
+    Returns
+    -------
+    V : (n, 3) float64
+        Vertex positions in the file's units.
+    F : (m, 3) int64
+        Triangles, 0-based, in the file's order and orientation.
+    report : MeshReport
+        Only when ``report=True``.
+
+    Raises
+    ------
+    MeshError
+        Missing or unreadable file, unknown extension, empty file, vertices
+        without faces, malformed line (line number), NaN or infinite
+        coordinates (vertex indices), face indices out of range (faces, lines,
+        the index and the vertex count), faces repeating a vertex.
+    """
+    where = os.fspath(path)
+    p = Path(where)
+    ext = p.suffix.lower()
+    if not p.exists():
+        raise MeshError(f"{where}: no such file")
+    if p.is_dir():
+        raise MeshError(f"{where}: is a directory, not a mesh file")
+    if ext not in SUPPORTED_EXTENSIONS:
+        raise MeshError(
+            f"{where}: unknown mesh format {ext or '(no extension)'!r}; supported: {', '.join(SUPPORTED_EXTENSIONS)}"
+        )
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise MeshError(f"{where}: cannot read the file: {exc.strerror or exc}") from None
+    if not data.strip():
+        raise MeshError(f"{where}: the file is empty")
+    if ext == ".obj":
+        V, F = _read_obj(data, where)
+    elif ext == ".off":
+        V, F = _read_off(data, where)
+    else:
+        V, F = _read_trimesh(p, where, ext)
+    rep = check_mesh(V, F)
+    if report:
+        return V, F, rep
+    if not rep.ok:
+        warnings.warn(MeshWarning(f"{where}: {rep.summary()}"), stacklevel=2)
+    return V, F
+
+
+def _write_obj(path, V, F):
+    n, m = len(V), len(F)
+    head = f"# {n} vertices, {m} triangles; 1-based indices, counter-clockwise seen from outside\n"
+    # %.17g gives every float64 back exactly when read again
+    vtext = ("v %.17g %.17g %.17g\n" * n) % tuple(V.ravel().tolist())
+    ftext = ("f %d %d %d\n" * m) % tuple((F + 1).ravel().tolist())
+    with open(path, "w", encoding="ascii", newline="\n") as fh:
+        fh.write(head)
+        fh.write(vtext)
+        fh.write(ftext)
+
+
+def _write_off(path, V, F):
+    n, m = len(V), len(F)
+    vtext = ("%.17g %.17g %.17g\n" * n) % tuple(V.ravel().tolist())
+    ftext = ("3 %d %d %d\n" * m) % tuple(F.ravel().tolist())
+    with open(path, "w", encoding="ascii", newline="\n") as fh:
+        fh.write(f"OFF\n{n} {m} 0\n")
+        fh.write(vtext)
+        fh.write(ftext)
+
+
+def save_mesh(path, V, F):
+    """Write a triangle mesh; the format is chosen by the extension.
+
+    * ``.obj``, ``.off``: written by this module with ``%.17g``, so every
+      float64 coordinate reads back bit for bit; OBJ indices 1-based, OFF
+      0-based.
+    * ``.ply``: binary little-endian PLY through trimesh, float64 vertices,
+      exact round trip.
+    * ``.stl``: binary STL through trimesh; STL stores float32 corners per
+      facet, so coordinates are rounded to float32 and a reload gives three
+      vertices per facet (see :func:`load_mesh`).
+
+    Vertex order and faces are written as given (no merging, no reordering).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    V : (n, 3) float64
+    F : (m, 3) int64
+
+    Raises
+    ------
+    MeshError
+        Invalid ``V``/``F`` (see :func:`geomlib.validate.as_mesh`) or an
+        unknown extension.
+    """
+    where = os.fspath(path)
+    ext = Path(where).suffix.lower()
+    if ext not in SUPPORTED_EXTENSIONS:
+        raise MeshError(
+            f"{where}: unknown mesh format {ext or '(no extension)'!r}; supported: {', '.join(SUPPORTED_EXTENSIONS)}"
+        )
+    V, F = as_mesh(V, F)
+    try:
+        if ext == ".obj":
+            _write_obj(where, V, F)
+        elif ext == ".off":
+            _write_off(where, V, F)
+        else:
+            import trimesh
+
+            mesh = trimesh.Trimesh(vertices=V, faces=F, process=False, validate=False)
+            if ext == ".ply":
+                blob = trimesh.exchange.ply.export_ply(mesh, encoding="binary", vertex_normal=False)
+            else:
+                blob = trimesh.exchange.stl.export_stl(mesh)
+            with open(where, "wb") as fh:
+                fh.write(blob)
+    except OSError as exc:
+        raise MeshError(f"{where}: cannot write the file: {exc.strerror or exc}") from None

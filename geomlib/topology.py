@@ -1,0 +1,405 @@
+"""Combinatorics of triangle meshes: edges, boundaries, valence, one-rings, Euler characteristic.
+
+Convention: ``F`` is an (m, 3) int64 array of 0-based vertex indices,
+counter-clockwise seen from outside. Face ``f`` traverses the directed edges
+``F[f,0] -> F[f,1] -> F[f,2] -> F[f,0]``; a boundary edge is an edge used by
+exactly one face and is reported in the direction that face traverses it, so
+walking along it the face lies on the left seen from outside.
+
+Everything is vectorised (one sort of the 3m half-edges) except the walks
+along boundary loops and around one vertex, which are short.
+Every function validates ``F`` at the door (:func:`geomlib.validate.as_faces`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components as _cc
+
+from .errors import MeshError, format_indices
+from .validate import as_faces, as_mesh
+
+__all__ = [
+    "edges",
+    "boundary_edges",
+    "boundary_vertices",
+    "boundary_loops",
+    "valence",
+    "one_ring",
+    "euler_characteristic",
+    "connected_components",
+    "vertex_face_adjacency",
+]
+
+_INT64_MAX = np.iinfo(np.int64).max
+
+
+def _sort_with_order(key):
+    """Sorted keys and the permutation that sorts them (stable).
+
+    When the keys are small enough the index is packed into the low digits
+    of the key and a plain ``np.sort`` is used: several times faster than
+    ``np.argsort`` on millions of half-edges.
+    """
+    k = len(key)
+    if k == 0:
+        return key, np.zeros(0, np.int64)
+    top = int(key.max())
+    if top < _INT64_MAX // max(k, 1) - 1:
+        packed = np.sort(key * k + np.arange(k, dtype=np.int64))
+        return packed // k, packed % k
+    order = np.argsort(key, kind="stable")
+    return key[order], order
+
+
+class _Topology:
+    """Half-edge bookkeeping shared by the functions below and check_mesh.
+
+    Half-edge ``h = 3 f + s`` runs from ``F[f, s]`` to ``F[f, (s + 1) % 3]``;
+    corner ``3 f + s`` is the corner of face f at vertex ``F[f, s]`` (so a
+    half-edge and the corner at its start share the index).
+    """
+
+    def __init__(self, F, n):
+        self.F, self.n = F, n
+        m = len(F)
+        self.I = F.ravel()
+        self.J = F[:, [1, 2, 0]].ravel()
+        lo = np.minimum(self.I, self.J)
+        hi = np.maximum(self.I, self.J)
+        sk, order = _sort_with_order(lo * np.int64(n) + hi)
+        first = np.empty(len(sk), bool)
+        first[:1] = True
+        np.not_equal(sk[1:], sk[:-1], out=first[1:])
+        starts = np.flatnonzero(first)
+        self.order = order
+        self.group_start = starts
+        self.edge_face_count = np.diff(np.append(starts, 3 * m))
+        key = sk[starts]
+        self.E = np.stack([key // n, key % n], axis=1)
+        self.vertex_face_count = np.bincount(self.I, minlength=n)
+
+    def boundary_halfedges(self):
+        p = self.group_start[self.edge_face_count == 1]
+        return np.sort(self.order[p])
+
+    def boundary_edges(self):
+        h = self.boundary_halfedges()
+        return np.stack([self.I[h], self.J[h]], axis=1)
+
+    def _pairs(self):
+        p = self.group_start[self.edge_face_count == 2]
+        return p, self.order[p], self.order[p + 1]
+
+    def inconsistent_edges(self):
+        p, h1, h2 = self._pairs()
+        same = self.I[h1] == self.I[h2]
+        return self.E[np.flatnonzero(self.edge_face_count == 2)[same]]
+
+    def fans_per_vertex(self):
+        """Number of face fans at each vertex (0 for unreferenced vertices).
+
+        Corners at the same vertex are linked when their faces share an edge
+        at that vertex; a fan is a connected set of corners.
+        """
+        m3 = len(self.I)
+        # every half-edge of an edge with >= 2 faces is linked to the group's first
+        multi = self.edge_face_count >= 2
+        gs = self.group_start[multi]
+        cnt = self.edge_face_count[multi]
+        first_pos = np.repeat(gs, cnt - 1)
+        other_pos = first_pos + (np.arange(int((cnt - 1).sum())) - np.repeat(np.cumsum(cnt - 1) - (cnt - 1), cnt - 1)) + 1
+        h1 = self.order[first_pos]
+        h2 = self.order[other_pos]
+        end1 = h1 - h1 % 3 + (h1 % 3 + 1) % 3
+        end2 = h2 - h2 % 3 + (h2 % 3 + 1) % 3
+        same = self.I[h1] == self.I[h2]
+        a = np.concatenate([h1, end1])
+        b = np.concatenate([np.where(same, h2, end2), np.where(same, end2, h2)])
+        G = sp.csr_matrix((np.ones(len(a), np.int8), (a, b)), shape=(m3, m3))
+        k, labels = _cc(G, directed=False)
+        comp_vertex = np.empty(k, np.int64)
+        comp_vertex[labels] = self.I
+        return np.bincount(comp_vertex, minlength=self.n)
+
+    def vertex_components(self):
+        """Component label per vertex through shared edges; -1 for unreferenced vertices."""
+        n = self.n
+        G = sp.csr_matrix((np.ones(len(self.E), np.int8), (self.E[:, 0], self.E[:, 1])), shape=(n, n))
+        _, labels = _cc(G, directed=False)
+        labels = labels.astype(np.int64)
+        unref = self.vertex_face_count == 0
+        if unref.any():
+            used = ~unref
+            _, labels[used] = np.unique(labels[used], return_inverse=True)
+            labels[unref] = -1
+        return labels
+
+    def duplicate_faces(self):
+        F, n = self.F, self.n
+        S = np.sort(F, axis=1)
+        if n ** 3 < _INT64_MAX:
+            key = (S[:, 0] * n + S[:, 1]) * n + S[:, 2]
+        else:  # rows as one void item each, compared bytewise
+            key = np.ascontiguousarray(S).view(np.dtype((np.void, 24))).ravel()
+        sk = np.sort(key)
+        if not (sk[1:] == sk[:-1]).any():
+            return np.zeros(0, np.int64)
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        dup = np.zeros(len(F), bool)
+        dup[1:] = sk[1:] == sk[:-1]
+        return np.sort(order[dup])
+
+
+def _nverts(F, n):
+    return int(F.max()) + 1 if n is None else int(n)
+
+
+def edges(F):
+    """Unique undirected edges, one row per edge, ``(e, 2)`` int64 sorted.
+
+    Each row holds the smaller vertex index first; rows are in
+    lexicographic order.
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+
+    Returns
+    -------
+    E : (e, 2) int64
+    """
+    F = as_faces(F)
+    return _Topology(F, _nverts(F, None)).E
+
+
+def boundary_edges(F):
+    """Boundary edges (used by exactly one face), directed as their face traverses them.
+
+    With faces counter-clockwise seen from outside, the face lies to the left
+    of each directed boundary edge. Rows are in the order of their faces
+    (face index, then the edge's position in the face).
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+
+    Returns
+    -------
+    B : (b, 2) int64
+        ``B[k] = (i, j)`` with the face traversing ``i -> j``. Empty (0, 2) for
+        a closed mesh.
+    """
+    F = as_faces(F)
+    return _Topology(F, _nverts(F, None)).boundary_edges()
+
+
+def boundary_vertices(F, n=None):
+    """Indices of the vertices on the boundary, sorted ascending (int64).
+
+    A vertex is on the boundary when it is an end of a boundary edge (an
+    edge with exactly one face). For a boolean mask use
+    ``mask = np.zeros(n, bool); mask[boundary_vertices(F)] = True``.
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+    n : int, optional
+        Number of vertices, only used to check the indices in ``F``.
+
+    Returns
+    -------
+    (k,) int64
+    """
+    F = as_faces(F, n)
+    B = _Topology(F, _nverts(F, n)).boundary_edges()
+    return np.unique(B)
+
+
+def _loops_from_edges(B):
+    """Chain directed boundary edges into loops (see :func:`boundary_loops`)."""
+    out = {}
+    for a, b in B.tolist():
+        out.setdefault(a, []).append(b)
+    loops = []
+    for s in sorted(out):
+        while out[s]:
+            loop = [s]
+            v = out[s].pop(0)
+            while v != s:
+                loop.append(v)
+                nxt = out.get(v)
+                if not nxt:  # chain that does not close (inconsistent orientation)
+                    break
+                v = nxt.pop(0)
+            loops.append(np.asarray(loop, dtype=np.int64))
+    return loops
+
+
+def boundary_loops(F):
+    """Boundary loops as ordered vertex index arrays, one per loop.
+
+    Each loop lists its vertices in the direction its faces traverse the
+    boundary edges (face on the left seen from outside), starting at the
+    loop's smallest vertex index; the first vertex is not repeated at the
+    end, so a loop of k edges has k vertices. Loops are ordered by their
+    first vertex. Where a vertex has two outgoing boundary edges (two loops
+    touching at a non-manifold vertex) the edges are taken in face order,
+    so the split into loops there is one of the possible ones.
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+
+    Returns
+    -------
+    list of (k_i,) int64 arrays; empty for a closed mesh.
+    """
+    return _loops_from_edges(boundary_edges(F))
+
+
+def valence(F, n=None):
+    """Number of distinct neighbours of each vertex (edges at the vertex).
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+    n : int, optional
+        Number of vertices; defaults to ``F.max() + 1``. Unreferenced vertices
+        have valence 0.
+
+    Returns
+    -------
+    (n,) int64
+    """
+    F = as_faces(F, n)
+    n = _nverts(F, n)
+    E = _Topology(F, n).E
+    return np.bincount(E.ravel(), minlength=n).astype(np.int64)
+
+
+def one_ring(F, i):
+    """Neighbours of vertex i in order, counter-clockwise around the outward normal.
+
+    With faces counter-clockwise seen from outside, each face ``(i, a, b)``
+    (rotated so i comes first) takes the ring from ``a`` to ``b``, and the
+    next face around i is the one containing ``(i, b, .)``.
+
+    * interior vertex of valence k: k neighbours; the ring starts at the
+      second vertex of the lowest-numbered face at i;
+    * boundary vertex with k faces: k + 1 neighbours from one boundary
+      neighbour to the other (the first is the end of the boundary edge
+      leaving i, the last the start of the one entering i);
+    * unreferenced vertex: an empty array.
+
+    O(m) per call (one scan of F).
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+    i : int
+
+    Returns
+    -------
+    (k,) int64
+
+    Raises
+    ------
+    MeshError
+        ``i`` out of range, or the faces at ``i`` do not form a single
+        consistently oriented fan (non-manifold vertex, non-manifold edge or
+        inconsistent orientation at i).
+    """
+    F = as_faces(F)
+    i = int(i)
+    if i < 0:
+        raise MeshError(f"one_ring: vertex index {i} is negative")
+    rows, cols = np.nonzero(F == i)
+    if len(rows) == 0:
+        return np.zeros(0, np.int64)
+    a = F[rows, (cols + 1) % 3]
+    b = F[rows, (cols + 2) % 3]
+    if len(np.unique(a)) < len(a) or len(np.unique(b)) < len(b):
+        raise MeshError(
+            f"one_ring: vertex {i} is not a manifold vertex with consistent orientation: an edge at it is "
+            f"traversed twice in one direction by faces {format_indices(rows)}"
+        )
+    succ = dict(zip(a.tolist(), b.tolist()))
+    starts = sorted(set(a.tolist()) - set(b.tolist()))
+    if len(starts) > 1:
+        raise MeshError(
+            f"one_ring: vertex {i} is non-manifold: its faces {format_indices(rows)} form {len(starts)} "
+            "separate fans"
+        )
+    start = starts[0] if starts else int(a[0])
+    ring = [start]
+    v = succ.get(start)
+    while v is not None and v != start:
+        ring.append(v)
+        v = succ.get(v)
+    visited_faces = len(ring) - (0 if v == start else 1)
+    if visited_faces != len(rows):
+        raise MeshError(
+            f"one_ring: vertex {i} is non-manifold: its faces {format_indices(rows)} form more than one fan "
+            f"(the fan from neighbour {start} covers {visited_faces} of {len(rows)} faces)"
+        )
+    return np.asarray(ring, dtype=np.int64)
+
+
+def euler_characteristic(V, F):
+    """Euler characteristic ``chi = V - E + F`` of the surface the faces form.
+
+    Only vertices used by at least one face are counted (an unreferenced
+    vertex is not part of the surface), so a closed sphere gives 2, a torus
+    0 and a disk 1, whatever stray vertices the file holds.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64
+
+    Returns
+    -------
+    int
+    """
+    V, F = as_mesh(V, F)
+    T = _Topology(F, len(V))
+    used = int(np.count_nonzero(T.vertex_face_count))
+    return used - len(T.E) + len(F)
+
+
+def connected_components(F, n=None):
+    """Label of the connected component of each vertex (faces linked by shared vertices).
+
+    Components are numbered 0, 1, ... in the order of their smallest vertex
+    index; unreferenced vertices get label -1. The number of components is
+    ``labels.max() + 1``.
+
+    Parameters
+    ----------
+    F : (m, 3) int64
+    n : int, optional
+        Number of vertices; defaults to ``F.max() + 1``.
+
+    Returns
+    -------
+    labels : (n,) int64
+    """
+    F = as_faces(F, n)
+    return _Topology(F, _nverts(F, n)).vertex_components()
+
+
+def vertex_face_adjacency(F, n=None):
+    """Sparse (n, m) incidence matrix, ``A[i, f] = 1`` when vertex i is a corner of face f.
+
+    Returns a ``scipy.sparse.csr_matrix`` of int8; ``A @ x`` sums a per-face
+    quantity ``x`` over the faces at each vertex, ``A.sum(axis=1)`` counts them.
+    """
+    F = as_faces(F, n)
+    n = _nverts(F, n)
+    m = len(F)
+    return sp.csr_matrix(
+        (np.ones(3 * m, np.int8), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m)
+    )
