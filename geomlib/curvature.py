@@ -1,19 +1,61 @@
-"""Discrete mean and Gaussian curvature (pointwise values, in 1/length and 1/length^2).
+"""Discrete mean and Gaussian curvature: pointwise values, H in 1/length, K in 1/length^2.
 
 Sign convention: ``Delta x = -2 H n`` with ``Delta = M^-1 C`` (geomlib.laplace)
-and ``n`` the outward unit normal; ``H > 0`` on a sphere.
+and ``n`` the outward unit normal; ``H > 0`` and ``K > 0`` on a sphere.
+
+Boundary rules, in one place (each function's docstring repeats its own):
+
+* ``mean_curvature``: ``boundary="formula"`` (default) applies ``1/2 |Delta x|``
+  everywhere. At a boundary vertex the one-ring is incomplete, ``Delta x`` has a
+  large in-plane component and the value is not a curvature estimate (it is
+  large even on a flat plane). ``"nan"`` masks boundary vertices, ``"zero"``
+  sets them to 0.
+* ``gaussian_curvature``: ``boundary="nan"`` (default) masks boundary vertices,
+  because the angle deficit ``2 pi - sum theta`` is not defined there;
+  ``"zero"``; ``"turning"``: the boundary turning angle ``pi - sum theta``
+  (the discrete geodesic curvature of the boundary), with which the integrated
+  values sum to ``2 pi chi`` exactly (Gauss-Bonnet with the boundary term);
+  ``"deficit"``: the interior formula applied anyway (what a naive
+  implementation reports, about ``pi / A`` too large on a flat boundary).
+
+A boundary vertex is a vertex of an edge that belongs to exactly one triangle.
+
+Bad input (each named in a MeshWarning, never a silent NaN): a vertex in no
+triangle of non-zero area gets NaN (its area is 0, nothing can be divided by
+it); a zero-area triangle counts as flat and collinear (angle pi at the corner
+opposite its longest edge, 0 at the others), so Gauss-Bonnet stays exact; at a
+non-manifold vertex (several fans of triangles) the deficit is
+``2 pi - sum theta`` over all its triangles, which keeps the total equal to
+``2 pi chi`` of the mesh as given but is not a pointwise curvature estimate;
+edges with three or more triangles are reported and counted as interior.
 """
 
 import warnings
 
 import numpy as np
+import scipy.sparse as sp
 
 from .errors import MeshError, MeshWarning, format_indices
-from .laplace import _as_mesh, face_geometry, laplacian
+from .laplace import _as_mesh, _check_options, _geometry, _vertex_areas, face_geometry, laplacian
+
+__all__ = [
+    "mean_curvature",
+    "gaussian_curvature",
+    "principal_curvatures",
+    "angle_sums",
+    "vertex_normals",
+    "face_normals",
+    "boundary_mask",
+    "BOUNDARY_RULES",
+    "MEAN_BOUNDARY_RULES",
+]
+
+BOUNDARY_RULES = ("nan", "zero", "turning", "deficit")
+MEAN_BOUNDARY_RULES = ("formula", "nan", "zero")
 
 
 def face_normals(V, F):
-    """Unit face normals (m, 3), right-hand rule on (v0, v1, v2); zero for degenerate faces."""
+    """Unit face normals (m, 3) float64, right-hand rule on (v0, v1, v2); zero for zero-length cross products."""
     N = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
     length = np.linalg.norm(N, axis=1)
     ok = length > 0
@@ -23,9 +65,11 @@ def face_normals(V, F):
 
 
 def vertex_normals(V, F):
-    """Area-weighted unit vertex normals (n, 3): the normalised sum of the
-    incident faces' cross products (outward on a consistently oriented closed
-    mesh). Isolated vertices get a zero vector."""
+    """Area-weighted unit vertex normals (n, 3) float64, outward for CCW faces.
+
+    The normalised sum of the incident faces' cross products (outward on a
+    consistently oriented closed mesh). Isolated vertices get a zero vector.
+    """
     V, F = _as_mesh(V, F)
     N2 = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])  # 2 A n per face
     n = len(V)
@@ -37,125 +81,235 @@ def vertex_normals(V, F):
     return N
 
 
+def _edge_counts(F, n):
+    """Per-vertex number of boundary edges (n,) int and the non-manifold edges (k, 2).
+
+    Counts the triangles of every undirected edge with one sparse assembly
+    (a counting sort, O(n + m)), no np.unique.
+    """
+    it = np.int32 if n < np.iinfo(np.int32).max else np.int64
+    I = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    J = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    lo = np.minimum(I, J).astype(it)
+    hi = np.maximum(I, J).astype(it)
+    E = sp.coo_matrix((np.ones(len(lo), np.int32), (lo, hi)), shape=(n, n)).tocsr()
+    E.sum_duplicates()
+    rows = np.repeat(np.arange(n, dtype=it), np.diff(E.indptr))
+    one = E.data == 1
+    b = np.bincount(rows[one], minlength=n) + np.bincount(E.indices[one], minlength=n)
+    many = E.data > 2
+    nonmanifold = np.column_stack([rows[many], E.indices[many]]).astype(np.int64)
+    return b, nonmanifold
+
+
+def _edge_list(E, limit=5):
+    head = ", ".join(f"({a}, {b})" for a, b in E[:limit].tolist())
+    return head + (f" (and {len(E) - limit} more)" if len(E) > limit else "")
+
+
+def boundary_mask(V, F):
+    """Boolean (n,): True at vertices of an edge that belongs to exactly one triangle."""
+    V, F = _as_mesh(V, F)
+    return _edge_counts(F, len(V))[0] > 0
+
+
+def _warn(message, stacklevel=3):
+    warnings.warn(message, MeshWarning, stacklevel=stacklevel + 1)
+
+
 def _laplace_of_positions(V, F, weights, area):
     M, C = laplacian(V, F, weights=weights, area=area)
     m = M.diagonal()
     CV = C @ V
     isolated = m <= 0
     if isolated.any():
-        warnings.warn(
+        _warn(
             f"{isolated.sum()} vertex/vertices belong to no triangle of non-zero area; "
             f"their curvature is undefined and returned as NaN: vertices "
             f"{format_indices(np.flatnonzero(isolated))}",
-            MeshWarning,
-            stacklevel=3,
         )
     with np.errstate(divide="ignore", invalid="ignore"):
         DV = CV / np.where(isolated, np.nan, m)[:, None]
     return DV
 
 
-def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False):
-    """Pointwise mean curvature H (n,) from ``Delta x = -2 H n``: ``H = 1/2 |Delta x|``.
+def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boundary="formula"):
+    """Pointwise mean curvature H (n,) float64 from ``Delta x = -2 H n``: ``H = 1/2 |Delta x|``.
 
-    With ``signed=True``, ``H = -1/2 <Delta x, n>`` with ``n`` the area-weighted
-    outward vertex normal, so H > 0 on a sphere and H < 0 where the surface
-    bends away from its normal the other way (a saddle region can have either).
-    Units 1/length for ``weights="cotan"``; for ``weights="uniform"`` the
-    operator carries no metric and ``1/2 |Delta x|`` has units of length (it
-    measures the umbrella vector, Taubin 1995), which is why the uniform value
-    depends on tessellation and scale.
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64, counter-clockwise seen from outside.
+    weights, area
+        As in :func:`geomlib.laplacian`.
+    signed : bool
+        False: ``H = 1/2 |Delta x| >= 0``. True: ``H = -1/2 <Delta x, n>``
+        with ``n`` the area-weighted outward vertex normal, so H > 0 on a
+        sphere and H < 0 where the surface bends away from its normal.
+    boundary : {"formula", "nan", "zero"}
+        Value at boundary vertices: the formula applied anyway (default; not a
+        curvature estimate there, see below), NaN, or 0.
 
-    Boundary vertices: the value is computed by the same formula, but the
-    one-ring is incomplete there, so ``Delta x`` has an in-plane component and
-    H is not an estimate of the curvature (it is large even on a flat plane).
-    Isolated vertices give NaN with a MeshWarning naming them.
-    Meyer et al. 2003, section 3.5; Desbrun et al. 1999.
+    Returns
+    -------
+    H : (n,) float64
+        In 1/length for ``weights="cotan"``. For ``weights="uniform"`` the
+        operator carries no metric and ``1/2 |Delta x|`` is half the length of
+        the umbrella vector (Taubin 1995): units of length, dependent on the
+        tessellation and the scale, not a curvature.
+
+    Notes
+    -----
+    Boundary vertices: the one-ring is incomplete, so ``Delta x`` has an
+    in-plane component and the formula's value is large even on a flat plane.
+    Vertices in no triangle of non-zero area give NaN with a MeshWarning
+    naming them. Meyer et al. 2003, section 3.5; Desbrun et al. 1999.
     """
+    _check_options(weights, area)
+    if boundary not in MEAN_BOUNDARY_RULES:
+        raise MeshError(f"boundary must be one of {MEAN_BOUNDARY_RULES}, not {boundary!r}")
     V, F = _as_mesh(V, F)
     DV = _laplace_of_positions(V, F, weights, area)
     if signed:
         N = vertex_normals(V, F)
-        return -0.5 * np.einsum("ij,ij->i", DV, N)
-    return 0.5 * np.linalg.norm(DV, axis=1)
+        H = -0.5 * np.einsum("ij,ij->i", DV, N)
+    else:
+        H = 0.5 * np.sqrt(np.einsum("ij,ij->i", DV, DV))
+    if boundary != "formula":
+        on_boundary = _edge_counts(F, len(V))[0] > 0
+        H[on_boundary] = np.nan if boundary == "nan" else 0.0
+    return H
 
 
-BOUNDARY_RULES = ("nan", "zero", "turning", "deficit")
+def _angles(l2, dblA, degenerate):
+    """Corner angles (3, m) in radians from the (3, m) geometry.
+
+    ``atan2(2A, l_j^2 + l_k^2 - l_i^2)`` (accurate for needles). A zero-area
+    triangle counts as collinear: pi at the corner opposite its longest edge,
+    0 at the others, so every triangle's angles sum to pi.
+    """
+    dot = 0.5 * l2.sum(axis=0) - l2  # <e_j, e_k> at each corner
+    theta = np.arctan2(np.broadcast_to(dblA, l2.shape), dot)
+    if degenerate.any():
+        d = np.flatnonzero(degenerate)
+        theta[:, d] = 0.0
+        theta[np.argmax(l2[:, d], axis=0), d] = np.pi
+    return theta
 
 
 def angle_sums(V, F):
-    """Sum of the triangle angles at each vertex (n,), radians. Degenerate faces add 0."""
+    """Sum of the triangle angles at each vertex (n,) float64, radians.
+
+    Zero-area triangles count as collinear (pi at the corner opposite the
+    longest edge). Unreferenced vertices get 0.
+    """
     V, F = _as_mesh(V, F)
-    _, dblA, cot, degenerate = face_geometry(V, F)
-    angles = np.arctan2(np.where(degenerate, 0.0, 1.0)[:, None], cot)
-    angles[degenerate] = 0.0
-    return np.bincount(F.ravel(), weights=angles.ravel(), minlength=len(V))
+    l2, dblA, _, degenerate = _geometry(V, F)
+    theta = _angles(l2, dblA, degenerate)
+    return np.bincount(F.T.ravel(), weights=theta.ravel(), minlength=len(V))
 
 
 def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=False):
-    """Pointwise Gaussian curvature K (n,) by the angle deficit, in 1/length^2.
+    """Pointwise Gaussian curvature K (n,) float64 by the angle deficit, in 1/length^2.
 
     ``K_i = (2 pi - sum_j theta_j) / A_i`` at interior vertices, with ``A_i``
-    the barycentric or mixed vertex area (Meyer et al. 2003, section 4).
-    With ``integrated=True`` the deficit itself (radians) is returned.
+    the barycentric or mixed vertex area (Meyer et al. 2003, section 4;
+    the deficit is exact for Gauss-Bonnet: its sum is ``2 pi chi``).
 
-    Boundary vertices (vertices on an edge with only one triangle) have no
-    angle deficit in the interior sense. ``boundary`` selects what is returned:
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64
+    area : {"barycentric", "mixed"}
+        The vertex area that normalises the deficit (geomlib.laplace).
+    boundary : {"nan", "zero", "turning", "deficit"}
+        The value at boundary vertices (vertices of an edge with only one
+        triangle), where the angle deficit is not defined:
 
-    * ``"nan"`` (default): NaN, because the quantity is undefined there; use
-      ``np.nanmean`` etc. or a mask from ``geomlib.boundary_vertices``.
-    * ``"zero"``: 0.
-    * ``"turning"``: ``(pi - sum theta) / A_i``, the discrete geodesic
-      curvature (turning angle) of the boundary; with it, the integrated
-      values sum to ``2 pi chi`` (Gauss-Bonnet with the boundary term).
-    * ``"deficit"``: the interior formula applied anyway (``2 pi - sum``),
-      which is what a naive implementation reports: large and meaningless.
+        * ``"nan"`` (default): NaN, the quantity is undefined; use
+          ``np.nanmean`` etc.
+        * ``"zero"``: 0.
+        * ``"turning"``: the turning angle ``pi - sum theta`` (divided by
+          ``A_i`` unless ``integrated``), the discrete geodesic curvature of
+          the boundary. With it the integrated values sum to ``2 pi chi``
+          exactly (discrete Gauss-Bonnet with the boundary term). At a vertex
+          with ``b`` boundary edges (a non-manifold "bow-tie") the term is
+          ``2 pi - b pi / 2 - sum theta``, which keeps the identity.
+        * ``"deficit"``: the interior formula ``2 pi - sum theta`` applied
+          anyway: what a naive implementation reports; large and meaningless.
+    integrated : bool
+        Return the deficit itself (radians, a curvature integrated over the
+        vertex area) instead of the pointwise value.
+
+    Returns
+    -------
+    K : (n,) float64
+
+    Notes
+    -----
+    Vertices in no triangle, or only in zero-area triangles, have area 0:
+    their pointwise K is NaN and a MeshWarning names them (an unreferenced
+    vertex's integrated value is NaN too). Zero-area triangles count as
+    collinear (pi at one corner) so the total stays ``2 pi chi``. A mesh whose
+    every vertex lies on the boundary gets a MeshWarning (with the default
+    rule every value is NaN). See the module docstring for non-manifold
+    vertices and edges.
     """
+    _check_options(area=area)
     if boundary not in BOUNDARY_RULES:
         raise MeshError(f"boundary must be one of {BOUNDARY_RULES}, not {boundary!r}")
     V, F = _as_mesh(V, F)
     n = len(V)
-    l2, dblA, cot, degenerate = face_geometry(V, F)
-    angles = np.arctan2(np.ones_like(cot), cot)  # angle from its cotangent, in (0, pi)
-    angles[degenerate] = 0.0
-    total = np.bincount(F.ravel(), weights=angles.ravel(), minlength=n)
-    deficit = 2.0 * np.pi - total
-    on_boundary = _boundary_mask(F, n)
-    if boundary == "turning":
-        deficit[on_boundary] = np.pi - total[on_boundary]
-    elif boundary == "zero":
-        deficit[on_boundary] = 0.0
-    elif boundary == "nan":
-        deficit[on_boundary] = np.nan
+    l2, dblA, cot, degenerate = _geometry(V, F)
+    theta = _angles(l2, dblA, degenerate)
+    deficit = 2.0 * np.pi - np.bincount(F.T.ravel(), weights=theta.ravel(), minlength=n)
+    if boundary != "deficit":
+        b, nonmanifold = _edge_counts(F, n)
+        on_boundary = b > 0
+        if len(nonmanifold):
+            _warn(f"{len(nonmanifold)} edge(s) belong to three or more triangles; they count as "
+                  f"interior edges: {_edge_list(nonmanifold)}")
+        if on_boundary.any():
+            if boundary == "turning":
+                deficit[on_boundary] -= 0.5 * np.pi * b[on_boundary]
+            else:
+                deficit[on_boundary] = np.nan if boundary == "nan" else 0.0
+            if on_boundary.all():
+                _warn(f"every vertex of this mesh lies on the boundary; the angle deficit is defined "
+                      f"nowhere (boundary={boundary!r} gives "
+                      f"{'NaN everywhere' if boundary == 'nan' else 'the rule at every vertex'})")
     referenced = np.bincount(F.ravel(), minlength=n) > 0
-    deficit[~referenced] = np.nan
+    if not referenced.all():
+        deficit[~referenced] = np.nan
     if integrated:
+        if not referenced.all():
+            _warn(f"{(~referenced).sum()} vertex/vertices are in no triangle; K is NaN there: "
+                  f"vertices {format_indices(np.flatnonzero(~referenced))}")
         return deficit
-    from .laplace import _vertex_areas
-
-    A = _vertex_areas(n, F, l2, dblA, cot, area)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return deficit / np.where(A > 0, A, np.nan)
-
-
-def _boundary_mask(F, n):
-    """Vertices on an edge used by exactly one face."""
-    E = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    key = E[:, 0] * np.int64(n) + E[:, 1]
-    uniq, counts = np.unique(key, return_counts=True)
-    b = uniq[counts == 1]
-    mask = np.zeros(n, bool)
-    mask[b // n] = True
-    mask[b % n] = True
-    return mask
+    A = _vertex_areas(n, F, l2, dblA, cot, area, degenerate)
+    no_area = A <= 0
+    if no_area.any():
+        _warn(f"{no_area.sum()} vertex/vertices have zero area (in no triangle of non-zero area); "
+              f"K is NaN there: vertices {format_indices(np.flatnonzero(no_area))}")
+        A = np.where(no_area, np.nan, A)
+    return deficit / A
 
 
 def principal_curvatures(H, K):
-    """Principal curvatures ``k1 >= k2`` (each (n,)) from H and K:
-    ``k1,2 = H +- sqrt(H^2 - K)``. Where the discrete ``H^2 - K`` is slightly
-    negative (it cannot be for a smooth surface) it is clamped to 0, so k1 = k2 = H
-    there; pass signed H."""
+    """Principal curvatures ``k1 >= k2`` (each (n,) float64) from signed H and K.
+
+    ``k1,2 = H +- sqrt(H^2 - K)``. Where the discrete ``H^2 - K`` is negative
+    (impossible for a smooth surface, common for discrete estimates at
+    umbilics) it is clamped to 0, so ``k1 = k2 = H`` there. Pass the signed
+    H (``mean_curvature(..., signed=True)``); NaN in either input gives NaN.
+    """
     H = np.asarray(H, dtype=float)
     K = np.asarray(K, dtype=float)
-    d = np.sqrt(np.maximum(H * H - K, 0.0))
+    with np.errstate(invalid="ignore"):
+        d = np.sqrt(np.maximum(H * H - K, 0.0))
     return H + d, H - d
+
+
+def _boundary_mask(F, n):
+    """Vertices on an edge used by exactly one face (boolean (n,))."""
+    return _edge_counts(np.asarray(F), n)[0] > 0
