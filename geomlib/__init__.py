@@ -57,6 +57,19 @@ _EXPORTS = {
     "explicit_step_limit": "smoothing",
     # noise and evaluation
     "add_noise": "noise",
+    "bounding_box_diagonal": "metrics",
+    "vertex_rms": "metrics",
+    "hausdorff_distance": "metrics",
+    "face_normal_angles": "metrics",
+    "normal_angle_error": "metrics",
+    "area_change": "metrics",
+    "volume_change": "metrics",
+    "dihedral_angles": "metrics",
+    "sharp_edges": "metrics",
+    "sharp_edge_error": "metrics",
+    "denoising_metrics": "metrics",
+    "MeshComparison": "metrics",
+    "point_surface_distance": "metrics",
 }
 
 __all__ = sorted(["MeshError", "MeshWarning", "data_path", *_EXPORTS])

@@ -1,0 +1,90 @@
+"""Seeded Gaussian noise: statistics, reproducibility, the input left alone."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from geomlib import MeshError, add_noise
+from geomlib.curvature import vertex_normals
+from geomlib.metrics import bounding_box_diagonal
+
+
+@pytest.fixture(scope="module")
+def sphere_10k():
+    mesh = trimesh.creation.icosphere(subdivisions=5, radius=2.0)  # 10242 vertices
+    return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
+
+
+@pytest.mark.parametrize("sigma", [0.001, 0.01, 0.05])
+def test_isotropic_noise_has_the_requested_standard_deviation(sphere_10k, sigma):
+    V, F = sphere_10k
+    assert len(V) >= 10_000
+    D = add_noise(V, F, sigma, seed=7) - V
+    target = sigma * bounding_box_diagonal(V)
+    # each coordinate is N(0, target^2): sample sd within 5 %, mean near 0
+    for axis in range(3):
+        assert abs(D[:, axis].std() / target - 1) < 0.05
+    assert np.abs(D.mean(axis=0)).max() < 5 * target / np.sqrt(len(V))
+    # coordinates are independent: the correlation matrix is close to I
+    R = np.corrcoef(D.T)
+    assert np.abs(R - np.eye(3)).max() < 0.05
+
+
+def test_normal_noise_moves_along_the_normal_only(sphere_10k):
+    V, F = sphere_10k
+    sigma = 0.01
+    D = add_noise(V, F, sigma, seed=3, direction="normal") - V
+    N = vertex_normals(V, F)
+    along = np.einsum("ij,ij->i", D, N)
+    tangential = D - along[:, None] * N
+    assert np.abs(tangential).max() < 1e-12 * bounding_box_diagonal(V)
+    assert abs(along.std() / (sigma * bounding_box_diagonal(V)) - 1) < 0.05
+
+
+def test_noise_is_relative_to_the_bounding_box_diagonal(sphere_10k):
+    # scaling the mesh scales the noise with it: the same seed gives s * D
+    V, F = sphere_10k
+    D1 = add_noise(V, F, 0.01, seed=11) - V
+    D2 = add_noise(3.5 * V, F, 0.01, seed=11) - 3.5 * V
+    np.testing.assert_allclose(D2, 3.5 * D1, rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("direction", ["isotropic", "normal"])
+def test_same_seed_same_noise_and_input_untouched(sphere_10k, direction):
+    V, F = sphere_10k
+    V0, F0 = V.copy(), F.copy()
+    A = add_noise(V, F, 0.02, seed=42, direction=direction)
+    B = add_noise(V, F, 0.02, seed=42, direction=direction)
+    C = add_noise(V, F, 0.02, seed=43, direction=direction)
+    assert np.array_equal(A, B)
+    assert not np.allclose(A, C)
+    assert np.array_equal(V, V0) and np.array_equal(F, F0)
+    assert A is not V and not np.shares_memory(A, V)
+
+
+def test_zero_sigma_returns_an_equal_copy(sphere_10k):
+    V, F = sphere_10k
+    W = add_noise(V, F, 0.0, seed=0)
+    assert np.array_equal(W, V) and not np.shares_memory(W, V)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    (dict(sigma=-0.1, seed=0), "sigma"),
+    (dict(sigma=float("nan"), seed=0), "sigma"),
+    (dict(sigma="a lot", seed=0), "sigma"),
+    (dict(sigma=0.1, seed=None), "seed"),
+    (dict(sigma=0.1, seed=0, direction="tangent"), "direction"),
+])
+def test_bad_arguments_raise_mesh_error(kwargs, words):
+    V = np.eye(3)
+    F = np.array([[0, 1, 2]])
+    with pytest.raises(MeshError, match=words):
+        add_noise(V, F, **kwargs)
+
+
+def test_bad_mesh_raises_mesh_error_naming_the_faces():
+    V = np.eye(3)
+    with pytest.raises(MeshError, match="faces 1"):
+        add_noise(V, np.array([[0, 1, 2], [0, 1, 5]]), 0.1, seed=0)
+    with pytest.raises(MeshError, match="vertices 1"):
+        add_noise(np.array([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]]), 0.1, seed=0)
