@@ -762,8 +762,12 @@ def side_by_side(*views, link_cameras=True):
         cam = first.camera
         cam.position = tuple(float(x) for x in _basis(VIEW_DIRECTION)[2] * distance)
         cam.near, cam.far = distance * 0.01, distance * 100.0
+        for v in views:
+            v._distance = distance
         for v in views[1:]:
+            v.width, v.height = first.width, first.height
             v.renderer.width, v.renderer.height = first.width, first.height
+            v._colorbar.value = v._colorbar_text()
             v.renderer.camera = cam
             v.renderer.controls = [first.controls]
             v.camera, v.controls = cam, first.controls

@@ -1,0 +1,315 @@
+"""Tests of geomlib.viewer: colour mapping, in-place updates, normals, the still
+picture in the display bundle, linked cameras and input checks.
+
+The browser side (does the canvas really show the mesh, does a slider change
+it, do linked cameras turn together) is tested in tests/browser/.
+"""
+
+import base64
+import io
+import re
+
+import ipywidgets
+import matplotlib
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+
+from geomlib import MeshError
+from geomlib.viewer import (NAN_COLOR, MeshView, colorize, render_still, side_by_side,
+                            value_range, vertex_normals_fast)
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    m = trimesh.creation.icosphere(subdivisions=3, radius=1.0)  # 642 vertices
+    return np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces, dtype=np.int64)
+
+
+@pytest.fixture
+def messages(monkeypatch):
+    """Every state message the widgets send: (widget class, changed keys)."""
+    sent = []
+    original = ipywidgets.Widget._send
+
+    def spy(self, msg, buffers=None):
+        if msg.get("method") == "update":
+            sent.append((type(self).__name__, sorted(msg.get("state", {}))))
+        return original(self, msg, buffers)
+
+    monkeypatch.setattr(ipywidgets.Widget, "_send", spy)
+    return sent
+
+
+# --- colour mapping ---------------------------------------------------------
+
+def test_colorize_maps_ends_middle_and_clips():
+    cm = matplotlib.colormaps["viridis"]
+    values = np.array([0.0, 5.0, 10.0, -3.0, 12.0])
+    colors = colorize(values, "viridis", vmin=0.0, vmax=10.0)
+    assert colors.shape == (5, 3) and colors.dtype == np.float32
+    np.testing.assert_allclose(colors[0], cm(0.0)[:3], atol=1e-6)
+    np.testing.assert_allclose(colors[2], cm(1.0)[:3], atol=1e-6)
+    np.testing.assert_allclose(colors[1], cm(0.5)[:3], atol=1 / 255 * 2)   # 256-entry table
+    np.testing.assert_allclose(colors[3], colors[0])                       # clipped below
+    np.testing.assert_allclose(colors[4], colors[2])                       # clipped above
+
+
+def test_nan_is_grey_and_counted(sphere):
+    V, F = sphere
+    values = V[:, 0].copy()
+    values[[3, 7, 11]] = np.nan
+    np.testing.assert_allclose(colorize(values, vmin=-1, vmax=1)[[3, 7, 11]], [NAN_COLOR] * 3, atol=1e-6)
+    view = MeshView(V, F, values=values)
+    np.testing.assert_allclose(view.colors[[3, 7, 11]], [NAN_COLOR] * 3, atol=1e-6)
+    assert not np.isnan(view.colors).any()
+    lo, hi = view.range
+    assert lo == pytest.approx(np.nanmin(values)) and hi == pytest.approx(np.nanmax(values))
+    assert "NaN (3)" in view._colorbar.value
+    assert "3 NaN drawn grey" in view.summary()
+
+
+def test_symmetric_range_is_centred_on_zero(sphere):
+    V, F = sphere
+    values = 3.0 * V[:, 1].clip(0, None) - 1.0 * V[:, 1].clip(None, 0) ** 2   # in [-1, 3]
+    assert value_range(values, symmetric=True) == pytest.approx((-3.0, 3.0))
+    assert value_range(values, symmetric=True, vmin=-0.5, vmax=2.0) == (-2.0, 2.0)
+    view = MeshView(V, F, values=values, symmetric=True)
+    assert view.cmap == "RdBu_r"                  # diverging by default for signed values
+    assert view.range == pytest.approx((-3.0, 3.0))
+    middle = matplotlib.colormaps["RdBu_r"](0.5)[:3]
+    zero = colorize(np.array([0.0]), "RdBu_r", *view.range)[0]
+    np.testing.assert_allclose(zero, middle, atol=2 / 255)
+    # opposite values get colours from opposite ends, mirrored in the map
+    plus, minus = colorize(np.array([2.0, -2.0]), "RdBu_r", -3.0, 3.0)
+    cm = matplotlib.colormaps["RdBu_r"]
+    np.testing.assert_allclose(plus, cm(5 / 6)[:3], atol=2 / 255)
+    np.testing.assert_allclose(minus, cm(1 / 6)[:3], atol=2 / 255)
+
+
+def test_constant_values_get_a_defined_range(sphere):
+    V, F = sphere
+    view = MeshView(V, F, values=np.zeros(len(V)), symmetric=True)
+    lo, hi = view.range
+    assert lo < 0 < hi
+    assert np.isfinite(view.colors).all()
+
+
+def test_colour_bar_shows_the_range_and_label(sphere):
+    V, F = sphere
+    view = MeshView(V, F, values=2.0 * V[:, 2], label="height (length)")
+    text = view._colorbar.value
+    assert "linear-gradient" in text and "height (length)" in text
+    assert ">-2<" in text and ">2<" in text
+    assert MeshView(V, F)._colorbar.layout.display == "none"   # no values, no colour bar
+
+
+# --- updates ----------------------------------------------------------------
+
+def test_update_overwrites_buffers_in_place_with_one_message(sphere, messages):
+    V, F = sphere
+    view = MeshView(V, F, values=V[:, 0], vmin=-2.0, vmax=2.0)
+    attributes = dict(view.geometry.attributes)
+    buffer = view._buffer
+    index = view.geometry.index
+    colors_before = view.colors
+    messages.clear()
+
+    W = 1.5 * V
+    view.update(V=W, values=W[:, 1])
+
+    assert messages == [("InterleavedBuffer", ["array"])]        # one message, one widget
+    assert view.geometry.index is index
+    for name, attribute in view.geometry.attributes.items():
+        assert attribute is attributes[name]
+        assert attribute.data is buffer
+    np.testing.assert_allclose(buffer.array[:, 0:3], W, rtol=1e-6)
+    np.testing.assert_allclose(view.colors, colorize(W[:, 1], "viridis", -2.0, 2.0), atol=1e-6)
+    assert not np.allclose(view.colors, colors_before)
+    assert buffer.array.dtype == np.float32 and buffer.array.shape == (len(V), 9)
+
+
+def test_update_values_only_keeps_positions(sphere):
+    V, F = sphere
+    view = MeshView(V, F, values=V[:, 0])
+    positions = view._buffer.array[:, 0:6].copy()
+    view.update(values=-V[:, 0])
+    np.testing.assert_array_equal(view._buffer.array[:, 0:6], positions)
+    np.testing.assert_allclose(view.values, -V[:, 0])
+    view.update(vmin=-10.0, vmax=10.0)
+    assert view.range == (-10.0, 10.0)
+
+
+def test_auto_range_follows_values(sphere):
+    V, F = sphere
+    view = MeshView(V, F, values=V[:, 0])
+    view.update(values=5.0 * V[:, 0])
+    assert view.range == pytest.approx((5.0 * V[:, 0].min(), 5.0 * V[:, 0].max()))
+    assert ">5<" in view._colorbar.value
+
+
+# --- normals ----------------------------------------------------------------
+
+def test_normals_on_a_sphere_are_radial():
+    m = trimesh.creation.icosphere(subdivisions=4, radius=1.0)  # 2562 vertices
+    V, F = np.asarray(m.vertices), np.asarray(m.faces)
+    radial = V / np.linalg.norm(V, axis=1, keepdims=True)
+    N = vertex_normals_fast(V, F)
+    assert np.abs(N - radial).max() < 1e-2
+    np.testing.assert_allclose(np.linalg.norm(N, axis=1), 1.0, atol=1e-12)
+    view = MeshView(V, F)
+    assert np.abs(view.normals - radial).max() < 1e-2
+    # moving the vertices moves the normals: an ellipsoid's normal is grad(x^2/a^2 + ...)
+    E = V * [1.0, 2.0, 3.0]
+    view.update(V=E)
+    g = E / np.array([1.0, 4.0, 9.0])
+    g /= np.linalg.norm(g, axis=1, keepdims=True)
+    assert np.abs(view.normals - g).max() < 5e-2
+
+
+def test_normals_flip_with_orientation(sphere):
+    V, F = sphere
+    np.testing.assert_allclose(vertex_normals_fast(V, F[:, ::-1]), -vertex_normals_fast(V, F), atol=1e-12)
+
+
+# --- display ----------------------------------------------------------------
+
+def _decode(bundle):
+    return np.asarray(Image.open(io.BytesIO(base64.b64decode(bundle["image/png"]))).convert("RGB"))
+
+
+def test_mimebundle_has_widget_png_and_text(sphere):
+    V, F = sphere
+    view = MeshView(V, F, values=V[:, 2], symmetric=True, title="sphere", label="z")
+    bundle = view._repr_mimebundle_()
+    assert set(bundle) >= {"application/vnd.jupyter.widget-view+json", "image/png", "text/plain"}
+    assert bundle["application/vnd.jupyter.widget-view+json"]["model_id"] == view.widget.model_id
+    image = _decode(bundle)
+    assert image.shape[1] == view.width and image.shape[0] >= view.height
+    pixels = image.reshape(-1, 3)
+    not_white = np.any(pixels < 245, axis=1).mean()
+    assert not_white > 0.1
+    assert len(np.unique(pixels, axis=0)) > 200              # shaded and coloured, not flat
+    reds = (pixels[:, 0] > pixels[:, 2] + 60).mean()         # the diverging map shows both ends
+    blues = (pixels[:, 2] > pixels[:, 0] + 60).mean()
+    assert reds > 0.01 and blues > 0.01
+    assert "642 vertices" in bundle["text/plain"] and "1280 faces" in bundle["text/plain"]
+    assert not re.search(r"[0-9a-f]{32}", bundle["text/plain"])  # no model ids in text
+
+
+def test_still_puts_the_mesh_in_the_middle():
+    # a unit square facing the camera direction fills the middle, corners stay background
+    from geomlib.viewer import VIEW_DIRECTION, _basis
+
+    right, up, w = _basis(VIEW_DIRECTION)
+    corners = np.array([-right - up, right - up, right + up, -right + up])
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    colors = np.tile([1.0, 0.0, 0.0], (4, 1))
+    image = render_still(corners, F, colors, width=100, height=80)
+    assert image.shape == (80, 100, 3)
+    assert image[40, 50, 0] > 200 and image[40, 50, 1] < 40     # red, lit head-on
+    assert (image[0, 0] == 255).all() and (image[-1, -1] == 255).all()
+    # nearer surfaces hide farther ones: a blue square in front covers the red one
+    V2 = np.vstack([corners, 0.5 * corners + 0.5 * w])
+    F2 = np.vstack([F, F + 4])
+    colors2 = np.vstack([colors, np.tile([0.0, 0.0, 1.0], (4, 1))])
+    image2 = render_still(V2, F2, colors2, width=100, height=80)
+    assert image2[40, 50, 2] > 200 and image2[40, 50, 0] < 40
+
+
+def test_plain_view_without_values(sphere):
+    V, F = sphere
+    view = MeshView(V, F, wireframe=True)
+    assert view.wireframe is not None
+    assert view.wireframe.geometry.attributes["position"] is view.geometry.attributes["position"]
+    n_edges = len(view.wireframe.geometry.index.array) // 2
+    assert n_edges == 3 * len(F) // 2                       # closed mesh: E = 3F/2
+    assert "coloured" not in view.summary()
+    image = view.still()
+    assert np.any(image < 245, axis=2).mean() > 0.1
+
+
+# --- side by side -----------------------------------------------------------
+
+def test_side_by_side_links_cameras(sphere):
+    V, F = sphere
+    a = MeshView(V, F, values=V[:, 0], title="a")
+    b = MeshView(2.0 * V + 5.0, F, values=V[:, 1], title="b", width=300, height=200)
+    c = MeshView(V, F)
+    row = side_by_side(a, b, c)
+    assert row.views == [a, b, c]
+    cameras = {id(v.renderer.camera) for v in row.views}
+    controls = {id(v.renderer.controls[0]) for v in row.views}
+    assert len(cameras) == 1 and len(controls) == 1
+    assert b.renderer.width == a.width and b.renderer.height == a.height
+    assert [child for child in row.widget.children] == [a.widget, b.widget, c.widget]
+    # the shared camera is framed on the largest mesh
+    assert np.linalg.norm(a.camera.position) == pytest.approx(row._distance)
+    assert row._distance > MeshView(V, F)._distance          # b is twice as large
+    bundle = row._repr_mimebundle_()
+    image = _decode(bundle)
+    assert image.shape[1] == 3 * a.width + 2 * 8
+    assert bundle["text/plain"].count("MeshView") == 3
+
+
+def test_side_by_side_without_linking_keeps_cameras(sphere):
+    V, F = sphere
+    a, b = MeshView(V, F), MeshView(V, F)
+    side_by_side(a, b, link_cameras=False)
+    assert a.renderer.camera is not b.renderer.camera
+
+
+# --- bad input --------------------------------------------------------------
+
+@pytest.mark.parametrize("V_bad, message", [
+    (np.zeros((5, 2)), "shape"),
+    (np.zeros(15), "shape"),
+])
+def test_bad_vertex_shapes(V_bad, message, sphere):
+    _, F = sphere
+    with pytest.raises(MeshError, match=message):
+        MeshView(V_bad, F[:1] * 0)
+
+
+def test_bad_faces_name_the_faces(sphere):
+    V, F = sphere
+    with pytest.raises(MeshError, match="shape"):
+        MeshView(V, F[:, :2])
+    G = F.copy()
+    G[[4, 9]] = len(V)
+    with pytest.raises(MeshError, match="faces 4, 9"):
+        MeshView(V, G)
+    with pytest.raises(MeshError, match="no faces"):
+        MeshView(V, np.zeros((0, 3), dtype=np.int64))
+    with pytest.raises(MeshError, match="integer"):
+        MeshView(V, F + 0.5)
+
+
+def test_non_finite_input(sphere):
+    V, F = sphere
+    W = V.copy()
+    W[[2, 5]] = np.nan
+    with pytest.raises(MeshError, match="vertices 2, 5"):
+        MeshView(W, F)
+    values = V[:, 0].copy()
+    values[8] = np.inf
+    with pytest.raises(MeshError, match="infinite at vertices 8"):
+        MeshView(V, F, values=values)
+
+
+def test_values_of_wrong_length(sphere):
+    V, F = sphere
+    with pytest.raises(MeshError, match=r"one number per vertex, shape \(642,\)"):
+        MeshView(V, F, values=np.zeros(len(V) - 1))
+    view = MeshView(V, F, values=V[:, 0])
+    with pytest.raises(MeshError, match="one number per vertex"):
+        view.update(values=np.zeros(len(V) + 3))
+    with pytest.raises(MeshError, match="642"):
+        view.update(V=V[:-1])
+    with pytest.raises(MeshError, match="shape"):
+        view.update(V=V[:, :2])
+    with pytest.raises(MeshError, match="colour map"):
+        MeshView(V, F, values=V[:, 0], cmap="no-such-map")
+    with pytest.raises(MeshError, match="MeshView"):
+        side_by_side(view, "not a view")
