@@ -123,6 +123,15 @@ def _tidy(expr, full=False):
     return min(cands, key=sp.count_ops)
 
 
+def _subs_tidy(val, sub):
+    """Substitute into an expression, matrix or tuple of them and simplify each entry."""
+    if isinstance(val, tuple):
+        return tuple(_subs_tidy(x, sub) for x in val)
+    if isinstance(val, sp.MatrixBase):
+        return val.subs(sub).applyfunc(_tidy)
+    return _tidy(sp.sympify(val).subs(sub))
+
+
 def _dot(a, b):
     return sum(a[i] * b[i] for i in range(3))
 
@@ -248,11 +257,7 @@ class ParametricSurface:
         return self._cache[key]
 
     def _substitute(self, val):
-        if isinstance(val, tuple):
-            return tuple(self._substitute(x) for x in val)
-        if isinstance(val, sp.MatrixBase):
-            return val.subs(self.values).applyfunc(_tidy)
-        return _tidy(sp.sympify(val).subs(self.values))
+        return _subs_tidy(val, self.values)
 
     # ------------------------------------------------- family computations (_c_*)
     # Everything is kept in the structured form
@@ -413,6 +418,7 @@ class ParametricSurface:
         return self._get("frame_coefficients", self._c_frame_coefficients)
 
     def _at(self, expr, u, v):
+        """expr (this surface's, or a tuple/matrix of them) at (u, v), simplified."""
         if u is None and v is None:
             return expr
         sub = {}
@@ -420,11 +426,22 @@ class ParametricSurface:
             sub[self.u] = sp.sympify(u)
         if v is not None:
             sub[self.v] = sp.sympify(v)
-        if isinstance(expr, tuple):
-            return tuple(self._at(x, u, v) for x in expr)
-        if isinstance(expr, sp.MatrixBase):
-            return expr.subs(sub).applyfunc(_tidy)
-        return _tidy(expr.subs(sub))
+        return _subs_tidy(expr, sub)
+
+    def _point(self, key, u, v):
+        """A cached family result at (u, v) with this surface's values, substituted once."""
+        if u is None and v is None:
+            return self._get(key, getattr(self, "_c_" + key))
+        ckey = ("at", key, sp.sympify(u) if u is not None else None, sp.sympify(v) if v is not None else None)
+        if ckey not in self._cache:
+            src = self._family or self
+            sub = dict(self.values)
+            if u is not None:
+                sub[self.u] = sp.sympify(u)
+            if v is not None:
+                sub[self.v] = sp.sympify(v)
+            self._cache[ckey] = _subs_tidy(src._get(key, getattr(src, "_c_" + key)), sub)
+        return self._cache[ckey]
 
     def normal_curvature(self, phi, u=None, v=None):
         """kappa_n(phi) = II(t, t) at (u, v), t = cos phi p_u/|p_u| + sin phi w (1/length).
@@ -435,12 +452,12 @@ class ParametricSurface:
         the surface's symbols. Positive where the surface bends away from the
         unit normal n (a sphere of radius r: 1/r for every phi).
         """
-        A, B, C = self.frame_coefficients()
+        A, B, C = self._point("frame_coefficients", u, v)
         phi = sp.sympify(phi)
         expr = A * sp.cos(phi) ** 2 + 2 * B * sp.sin(phi) * sp.cos(phi) + C * sp.sin(phi) ** 2
         if u is None and v is None:
             return expr
-        return self._at(expr, u, v)
+        return _tidy(expr)
 
     def principal_curvatures(self, u=None, v=None):
         """(k1, k2), k1 >= k2: H +- sqrt(H^2 - K) (1/length), at (u, v) or as functions of u, v.
@@ -450,7 +467,7 @@ class ParametricSurface:
         """
         if u is None and v is None:
             return self._get("principal_curvatures", self._c_principal_curvatures)
-        A, B, C = self._at(self.frame_coefficients(), u, v)
+        A, B, C = self._point("frame_coefficients", u, v)
         H = _tidy((A + C) / 2)
         R = _tidy(sp.sqrt(((A - C) / 2) ** 2 + B ** 2))
         return (_tidy(H + R), _tidy(H - R))
@@ -462,7 +479,7 @@ class ParametricSurface:
         d1, d2 are unit 3-vectors (3x1 sympy matrices). At an umbilic
         (A = C, B = 0) every direction is principal and phi1 = 0 is returned.
         """
-        A, B, C = self._at(self.frame_coefficients(), u, v)
+        A, B, C = self._point("frame_coefficients", u, v)
         diff = _tidy(A - C)
         if _tidy(B) == 0:
             # the frame is principal; which of e1, w has the larger curvature?
@@ -487,7 +504,7 @@ class ParametricSurface:
         e1 = p_u/|p_u|; w = m x e1 with m = p_u x p_v / |p_u x p_v|, i.e. the unit
         tangent perpendicular to p_u on the side of p_v.
         """
-        return self._at(self._get("frame", self._c_frame), u, v)
+        return self._point("frame", u, v)
 
     def position(self, u=None, v=None):
         """p(u, v) as a 3x1 sympy Matrix."""
