@@ -1,0 +1,300 @@
+"""Tests of geomlib.laplace: closed forms, matrix laws, bad triangles, libigl cross-checks."""
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import trimesh
+
+from geomlib import MeshError, MeshWarning, cotangent_weights, laplacian, load_mesh, vertex_areas
+from geomlib import surfaces
+
+SHIPPED = Path(__file__).resolve().parents[1] / "meshes"
+COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+
+AREAS = ("barycentric", "mixed")
+
+
+def icosphere(subdivisions=3, scale=(1.0, 1.0, 1.0)):
+    m = trimesh.creation.icosphere(subdivisions=subdivisions)
+    return np.asarray(m.vertices) * np.asarray(scale), np.asarray(m.faces, dtype=np.int64)
+
+
+def random_rotation(seed):
+    Q, R = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    Q = Q * np.sign(np.diag(R))
+    if np.linalg.det(Q) < 0:
+        Q[:, 0] *= -1
+    return Q
+
+
+def dense(A):
+    return np.asarray(A.todense())
+
+
+# ---------------------------------------------------------------- closed forms
+
+
+def test_right_triangle_cotan_entries():
+    # angles: 90 deg at vertex 0, 45 deg at vertices 1 and 2
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    F = np.array([[0, 1, 2]])
+    M, C = laplacian(V, F)
+    expected = np.array([[-1.0, 0.5, 0.5],
+                         [0.5, -0.5, 0.0],
+                         [0.5, 0.0, -0.5]])
+    np.testing.assert_allclose(dense(C), expected, atol=1e-15)
+    np.testing.assert_allclose(M.diagonal(), [1 / 6, 1 / 6, 1 / 6], atol=1e-15)
+    # right triangle is not obtuse: Voronoi areas 1/4 at the right angle, 1/8 at the others
+    M, _ = laplacian(V, F, area="mixed")
+    np.testing.assert_allclose(M.diagonal(), [1 / 4, 1 / 8, 1 / 8], atol=1e-15)
+
+
+def test_obtuse_triangle_mixed_area():
+    # angle of 120 degrees at vertex 0: A/2 there, A/4 at the others
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [np.cos(2 * np.pi / 3), np.sin(2 * np.pi / 3), 0]])
+    F = np.array([[0, 1, 2]])
+    A = 0.5 * np.sin(2 * np.pi / 3)
+    np.testing.assert_allclose(vertex_areas(V, F, "mixed"), [A / 2, A / 4, A / 4], atol=1e-15)
+    np.testing.assert_allclose(vertex_areas(V, F, "barycentric"), [A / 3] * 3, atol=1e-15)
+    C = dense(cotangent_weights(V, F))
+    # cot(120) = -1/sqrt(3) on the edge opposite vertex 0; cot(30) = sqrt(3) elsewhere
+    assert C[1, 2] == pytest.approx(-0.5 / np.sqrt(3), abs=1e-15)
+    assert C[0, 1] == pytest.approx(0.5 * np.sqrt(3), abs=1e-15)
+
+
+def test_uniform_is_graph_laplacian():
+    V, F = icosphere(2)
+    M, C = laplacian(V, F, weights="uniform")
+    A = dense(C) - np.diag(C.diagonal())
+    assert set(np.unique(A)) == {0.0, 1.0}
+    valence = A.sum(axis=1)
+    np.testing.assert_array_equal(M.diagonal(), valence)
+    np.testing.assert_array_equal(-C.diagonal(), valence)
+    assert set(valence) == {5.0, 6.0}
+
+
+def test_output_formats():
+    V, F = icosphere(1)
+    for weights in ("cotan", "uniform"):
+        M, C = laplacian(V, F, weights=weights)
+        assert sp.issparse(M) and sp.issparse(C)
+        assert C.format == "csr" and M.format in ("dia", "csr")
+        assert M.dtype == C.dtype == np.float64
+        assert dense(M - sp.diags(M.diagonal())).any() == False  # noqa: E712 (diagonal)
+
+
+def test_flat_mesh_reproduces_linear_functions():
+    # cotan C is exact on linear functions at interior vertices of any flat mesh
+    s = surfaces.plane(n=12, jitter=0.3, seed=1)
+    _, C = laplacian(s.V, s.F)
+    interior = np.ones(len(s.V), bool)
+    interior[np.unique(np.concatenate([np.flatnonzero(np.isclose(abs(s.V[:, k]), 1.0)) for k in (0, 1)]))] = False
+    f = 0.3 * s.V[:, 0] - 1.7 * s.V[:, 1] + 2.0
+    assert np.abs((C @ f)[interior]).max() < 1e-12
+
+
+def test_sphere_laplacian_of_position():
+    # Delta x = -2 H n, H = 1/r on a sphere of radius r. With vertices on the
+    # sphere, <x_j - x_i, n_i> = -|x_j - x_i|^2 / (2 r), so the normal part of
+    # C x is -1/r times the Voronoi area: exact with mixed areas on this
+    # non-obtuse mesh; barycentric areas are 15% off at the valence-5 vertices.
+    r = 2.5
+    V, F = icosphere(4)
+    V = r * V
+    n = V / np.linalg.norm(V, axis=1, keepdims=True)
+    for area, tol in (("mixed", 1e-12), ("barycentric", 0.16)):
+        M, C = laplacian(V, F, area=area)
+        DV = (C @ V) / M.diagonal()[:, None]
+        H = -0.5 * np.einsum("ij,ij->i", DV, n)
+        assert np.abs(H * r - 1).max() < tol
+        assert np.median(np.abs(H * r - 1)) < 0.001
+
+
+# ---------------------------------------------------------------- laws
+
+
+MESHES = {
+    "ellipsoid": lambda: icosphere(2, (1.0, 0.7, 0.5)),
+    "jittered_ellipsoid": lambda: (lambda s: (s.V, s.F))(surfaces.ellipsoid(1.0, 0.6, 0.4, 2, jitter=0.4, seed=3)),
+    "saddle_open": lambda: (lambda s: (s.V, s.F))(surfaces.saddle(n=12, jitter=0.3, seed=2)),
+    "torus": lambda: (lambda s: (s.V, s.F))(surfaces.torus(1.0, 0.35, n=24)),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+@pytest.mark.parametrize("weights,area", [("cotan", "barycentric"), ("cotan", "mixed"), ("uniform", "barycentric")])
+def test_symmetric_zero_rows_negative_semidefinite(name, weights, area):
+    V, F = MESHES[name]()
+    M, C = laplacian(V, F, weights=weights, area=area)
+    D = dense(C)
+    scale = np.abs(D).max()
+    np.testing.assert_allclose(D, D.T, atol=1e-14 * scale)
+    assert np.abs(D.sum(axis=1)).max() < 1e-13 * scale
+    lam = np.linalg.eigvalsh(D)
+    assert lam.max() < 1e-12 * scale
+    # exactly one zero eigenvalue per connected component
+    assert np.sum(np.abs(lam) < 1e-9 * scale) == 1
+    assert (M.diagonal() > 0).all()
+    assert np.isfinite(D).all() and np.isfinite(M.diagonal()).all()
+
+
+@pytest.mark.parametrize("area", AREAS)
+def test_areas_sum_to_surface_area(area):
+    V, F = MESHES["jittered_ellipsoid"]()
+    total = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
+    assert vertex_areas(V, F, area).sum() == pytest.approx(total, rel=1e-13)
+
+
+@pytest.mark.parametrize("s", [0.01, 3.0, 250.0])
+@pytest.mark.parametrize("area", AREAS)
+def test_scaling(s, area):
+    V, F = MESHES["jittered_ellipsoid"]()
+    M1, C1 = laplacian(V, F, area=area)
+    Ms, Cs = laplacian(s * V, F, area=area)
+    np.testing.assert_allclose(Ms.diagonal(), s * s * M1.diagonal(), rtol=1e-12)
+    assert abs(Cs - C1).max() < 1e-12 * abs(C1).max()
+    Mu, Cu = laplacian(s * V, F, weights="uniform")
+    Mu1, Cu1 = laplacian(V, F, weights="uniform")
+    assert abs(Cu - Cu1).max() == 0
+    np.testing.assert_array_equal(Mu.diagonal(), Mu1.diagonal())
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_rigid_motion_invariance(seed):
+    V, F = MESHES["saddle_open"]()
+    Q = random_rotation(seed)
+    W = V @ Q.T + np.array([3.0, -1.0, 0.5]) * (seed + 1)
+    for area in AREAS:
+        M1, C1 = laplacian(V, F, area=area)
+        M2, C2 = laplacian(W, F, area=area)
+        assert abs(C2 - C1).max() < 1e-12 * abs(C1).max()
+        np.testing.assert_allclose(M2.diagonal(), M1.diagonal(), rtol=1e-11)
+
+
+# ---------------------------------------------------------------- bad triangles and input
+
+
+def _mesh_with_bad_triangles():
+    """A flat fan plus a zero-area triangle (collinear), a near-collinear needle,
+    a triangle with two coincident vertices and an isolated vertex."""
+    V = np.array([
+        [0.0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0],  # 0-4: a fan
+        [2.0, 0, 0], [3.0, 0, 0],                                   # 5, 6: collinear with 1
+        [1.0, 1e-9, 0],                                              # 7: needle apex
+        [0.0, 1.0, 0],                                               # 8: coincides with 2
+        [9.0, 9.0, 9.0],                                             # 9: isolated
+    ])
+    F = np.array([
+        [0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1],
+        [1, 5, 6],   # zero area (collinear)
+        [3, 1, 7],   # needle: height 1e-9 over a base of length 2
+        [0, 2, 8],   # zero area (2 and 8 coincide)
+    ])
+    return V, F
+
+
+@pytest.mark.parametrize("weights,area", [("cotan", "barycentric"), ("cotan", "mixed"), ("uniform", "barycentric")])
+def test_bad_triangles_give_finite_matrices(weights, area):
+    V, F = _mesh_with_bad_triangles()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        M, C = laplacian(V, F, weights=weights, area=area)
+    D = dense(C)
+    assert np.isfinite(D).all() and np.isfinite(M.diagonal()).all()
+    np.testing.assert_allclose(D, D.T, atol=0)
+    assert np.abs(D.sum(axis=1)).max() < 1e-12 * np.abs(D).max()
+    assert np.linalg.eigvalsh(D).max() < 1e-12 * np.abs(D).max()
+    # isolated vertex: zero row and zero area
+    assert not D[9].any() and M.diagonal()[9] == 0
+    if weights == "cotan":
+        messages = [str(w.message) for w in caught if issubclass(w.category, MeshWarning)]
+        assert any("zero-area" in m and "faces 4, 6" in m for m in messages)
+        # the zero-area faces add nothing: vertices 5, 6 and 8 are in no other face
+        assert M.diagonal()[[5, 6, 8]].tolist() == [0.0, 0.0, 0.0]
+        assert not D[[5, 6, 8]].any()
+        # the needle keeps its exact, large but finite cotangent
+        # the needle (3, 1, 7) keeps its exact cotangent: the angle at 3 is atan(1e-9 / 2)
+        assert D[1, 7] == pytest.approx(0.5 * 2.0 / 1e-9, rel=1e-6)
+
+
+def test_needle_triangle_cotangent_is_exact():
+    h = 1e-9
+    V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, h, 0]])
+    C = dense(cotangent_weights(V, [[0, 1, 2]]))
+    # angle at the apex is pi - 2 atan(h): cot = (h^2 - 1) / (2 h)
+    assert C[0, 1] == pytest.approx(0.5 * (h * h - 1) / (2 * h), rel=1e-9)
+    assert C[0, 2] == pytest.approx(0.5 / h, rel=1e-9)
+
+
+def test_bad_options_raise():
+    V, F = icosphere(0)
+    with pytest.raises(MeshError, match="weights"):
+        laplacian(V, F, weights="cotangent")
+    with pytest.raises(MeshError, match="area"):
+        laplacian(V, F, area="voronoi")
+    with pytest.raises(MeshError):
+        laplacian(V, F[:, :2])
+    with pytest.raises(MeshError):
+        laplacian(V, F + len(V))
+    bad = V.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(MeshError, match="3"):
+        laplacian(bad, F)
+
+
+def test_non_manifold_edge_sums_its_triangles():
+    # three triangles on the edge (0, 1)
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -1, 0], [0.5, 0, 1]])
+    F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])
+    C = dense(cotangent_weights(V, F))
+    expected = sum(float(dense(cotangent_weights(V, [f]))[0, 1]) for f in F)
+    assert C[0, 1] == pytest.approx(expected, rel=1e-14)
+    assert np.linalg.eigvalsh(C).max() < 1e-14
+
+
+# ---------------------------------------------------------------- libigl cross-checks
+
+igl = pytest.importorskip("igl")
+
+
+def _against_libigl(V, F):
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    Mb, C = laplacian(V, F, area="barycentric")
+    Mv, _ = laplacian(V, F, area="mixed")
+    scale = abs(C).max()
+    assert abs(C - igl.cotmatrix(V, F)).max() < 1e-12 * scale
+    Mb_ref = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    Mv_ref = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    area = Mb_ref.max()
+    assert np.abs(Mb.diagonal() - Mb_ref).max() < 1e-12 * area
+    assert np.abs(Mv.diagonal() - Mv_ref).max() < 1e-12 * area
+
+
+@pytest.mark.parametrize("name", sorted(MESHES))
+def test_libigl_generated(name):
+    _against_libigl(*MESHES[name]())
+
+
+SHIPPED_MESHES = sorted(p.name for p in SHIPPED.glob("*.obj"))
+
+
+@pytest.mark.parametrize("name", SHIPPED_MESHES)
+def test_libigl_shipped_meshes(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        _against_libigl(*load_mesh(SHIPPED / name))
+
+
+COURSE_MESHES = sorted(str(p.relative_to(COURSE)) for p in COURSE.rglob("*.obj")) if COURSE.is_dir() else []
+
+
+@pytest.mark.skipif(not COURSE.is_dir(), reason="the course meshes (../shared/meshes) are not present")
+@pytest.mark.parametrize("name", COURSE_MESHES)
+def test_libigl_course_meshes(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        _against_libigl(*load_mesh(COURSE / name))
