@@ -97,12 +97,78 @@ class _Topology:
         same = self.I[h1] == self.I[h2]
         return self.E[np.flatnonzero(self.edge_face_count == 2)[same]]
 
-    def fans_per_vertex(self):
-        """Number of face fans at each vertex (0 for unreferenced vertices).
+    def non_manifold_vertices(self):
+        """Vertices whose faces form more than one fan, sorted.
 
         Corners at the same vertex are linked when their faces share an edge
         at that vertex; a fan is a connected set of corners.
         """
+        if (self.edge_face_count <= 2).all():
+            p, h1, h2 = self._pairs()
+            if (self.I[h1] != self.I[h2]).all():
+                return self._multi_fan_oriented(h1, h2)
+        return np.flatnonzero(self._fans_general() > 1)
+
+    def _successor(self, h1, h2):
+        """Successor of each corner around its vertex (oriented, manifold edges).
+
+        The corner after corner c at vertex v is the corner at v of the face
+        across the edge entering v in c's face; where that edge is a boundary
+        edge the successor is c itself (c ends an open fan). Also returns the
+        twin of each half-edge (-1 on the boundary).
+        """
+        m3 = len(self.I)
+        twin = np.full(m3, -1, np.int64)
+        twin[h1] = h2
+        twin[h2] = h1
+        c = np.arange(m3, dtype=np.int64)
+        k = c % 3
+        nxt = twin[c - k + (k + 2) % 3]
+        term = nxt < 0
+        nxt[term] = c[term]
+        return nxt, twin
+
+    def _multi_fan_oriented(self, h1, h2):
+        """Walk once around every vertex from one corner; compare the fan with all corners there.
+
+        A vertex has one fan when the walk from its representative corner
+        (the start of its open fan, or any corner when it has no boundary
+        edge) visits all of its corners. All vertices walk at once; the loop
+        runs as many steps as the largest fan has corners.
+        """
+        n = self.n
+        nxt, twin = self._successor(h1, h2)
+        ncorner = self.vertex_face_count
+        # open-fan starts: corners whose outgoing edge (half-edge c itself) is a boundary edge
+        starts = np.flatnonzero(twin < 0)
+        nstart = np.bincount(self.I[starts], minlength=n)
+        bad = nstart > 1  # two open fans at one vertex
+        rep = np.full(n, -1, np.int64)
+        rep[self.I] = np.arange(len(self.I))  # some corner at each vertex (any will do)
+        rep[self.I[starts]] = starts
+        verts = np.flatnonzero((ncorner > 0) & ~bad)
+        first = rep[verts]
+        cur = first
+        count = np.ones(len(verts), np.int64)
+        steps = 0
+        while len(verts):
+            nx = nxt[cur]
+            done = (nx == first) | (nx == cur)  # cycle closed, or open fan ended
+            if done.any():
+                fin = verts[done]
+                bad[fin[count[done] != ncorner[fin]]] = True
+                keep = ~done
+                verts, first, cur, count = verts[keep], first[keep], nx[keep], count[keep]
+            else:
+                cur = nx
+            count += 1
+            steps += 1
+            if steps > 3 * len(self.I):  # cannot happen for a valid successor map
+                raise RuntimeError("corner walk did not terminate")
+        return np.flatnonzero(bad)
+
+    def _fans_general(self):
+        """Fans by connected components of the corner graph (any mesh)."""
         m3 = len(self.I)
         # every half-edge of an edge with >= 2 faces is linked to the group's first
         multi = self.edge_face_count >= 2

@@ -327,12 +327,16 @@ def zero_area_faces(V, F, rtol=ZERO_AREA_RTOL):
     (scale-free). Faces with a repeated vertex never reach here
     (:func:`as_mesh` refuses them).
     """
-    P0, P1, P2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    e0, e1, e2 = P1 - P0, P2 - P1, P0 - P2
-    cross = np.cross(e0, -e2)
-    twice_area2 = np.einsum("ij,ij->i", cross, cross)
-    longest2 = np.maximum(np.maximum(np.einsum("ij,ij->i", e0, e0), np.einsum("ij,ij->i", e1, e1)),
-                          np.einsum("ij,ij->i", e2, e2))
+    X, Y, Z = (np.ascontiguousarray(V[:, k]) for k in range(3))
+    i, j, k = (np.ascontiguousarray(F[:, c]) for c in range(3))
+    # edge vectors a = P1 - P0 and b = P2 - P0, coordinate by coordinate
+    ax, ay, az = X[j] - X[i], Y[j] - Y[i], Z[j] - Z[i]
+    bx, by, bz = X[k] - X[i], Y[k] - Y[i], Z[k] - Z[i]
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    twice_area2 = cx * cx + cy * cy + cz * cz
+    la, lb = ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz
+    dx, dy, dz = bx - ax, by - ay, bz - az
+    longest2 = np.maximum(np.maximum(la, lb), dx * dx + dy * dy + dz * dz)
     return np.flatnonzero(twice_area2 <= (rtol * longest2) ** 2)
 
 
@@ -380,8 +384,7 @@ def check_mesh(V, F):
     zero = zero_area_faces(V, F)
     nm_edges = T.E[T.edge_face_count > 2]
     inconsistent = T.inconsistent_edges()
-    fans = T.fans_per_vertex()
-    nm_vertices = np.flatnonzero(fans > 1)
+    nm_vertices = T.non_manifold_vertices()
     labels = T.vertex_components()
     n_comp = int(labels.max()) + 1 if len(labels) else 0
     comp_sizes = np.bincount(labels[F[:, 0]], minlength=n_comp)
