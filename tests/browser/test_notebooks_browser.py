@@ -1,0 +1,136 @@
+"""Every notebook, run in JupyterLab in a real browser (headless Chromium).
+
+For each notebooks/*.ipynb (new notebooks are picked up automatically):
+
+1. open it, run all cells, wait until every code cell has run and the kernel is idle;
+2. no cell has an error output (stderr text such as tqdm's progress bars is fine);
+3. every 3D view (``.geomlib-canvas``) shows a picture: not one flat colour;
+4. the first slider sharing an ipywidgets box with a view (see the convention
+   in geomlib/viewer.py) is moved with the keyboard and the picture changes;
+5. where views are shown with ``side_by_side``, an orbit drag in the first one
+   also turns the second (linked cameras).
+
+Screenshots of the page and of every canvas: build/screenshots/NAME/.
+"""
+
+import os
+import time
+from pathlib import Path
+
+import pytest
+
+import lablib
+
+ROOT = Path(__file__).resolve().parents[2]
+# GEOMLIB_NOTEBOOK_DIR runs the same checks on another folder of notebooks
+NOTEBOOK_DIR = Path(os.environ.get("GEOMLIB_NOTEBOOK_DIR", ROOT / "notebooks"))
+NOTEBOOKS = sorted(p.name for p in NOTEBOOK_DIR.glob("*.ipynb"))
+RUN_TIMEOUT = 180          # seconds for one notebook to run top to bottom
+RENDER_TIMEOUT = 30        # seconds for a view to show a picture / react to a slider
+
+pytestmark = pytest.mark.browser
+
+
+def _wait_for(predicate, timeout, interval=0.3):
+    deadline = time.monotonic() + timeout
+    value = predicate()
+    while not value and time.monotonic() < deadline:
+        time.sleep(interval)
+        value = predicate()
+    return value
+
+
+def _not_blank(png):
+    distinct, covered = lablib.image_stats(png)
+    return distinct >= 20 and covered >= 0.01, distinct, covered
+
+
+def _format_errors(errors):
+    return "\n\n".join(f"cell {e['cell']}: {e['ename']}: {e['evalue']}\n{e['traceback'][-2000:]}" for e in errors)
+
+
+@pytest.mark.parametrize("notebook", NOTEBOOKS)
+def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
+    page = browser.new_page(viewport=lablib.VIEWPORT)
+    console = []
+    page.on("console", lambda m: console.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
+    page.on("pageerror", lambda e: console.append(f"pageerror: {e}"))
+    try:
+        lablib.open_notebook(page, lab_server, notebook)
+        state = lablib.run_all(page, timeout_s=RUN_TIMEOUT)
+        page.screenshot(path=str(screenshot_dir / "page.png"))
+
+        # 1-2: ran to the end without error outputs
+        assert not state.get("timeout"), (
+            f"{notebook} did not finish within {RUN_TIMEOUT} s: {state['done']} of {state['code']} code cells ran")
+        assert not state["errors"], f"{notebook} has error outputs:\n{_format_errors(state['errors'])}"
+        assert state["done"] == state["code"], f"only {state['done']} of {state['code']} code cells ran"
+
+        # 3: every view shows a picture
+        canvases = page.locator(".geomlib-canvas")
+        count = canvases.count()
+        assert count >= 1, f"{notebook} shows no MeshView (.geomlib-canvas)"
+        for i in range(count):
+            canvas = canvases.nth(i)
+            shot = {}
+
+            def rendered(i=i, canvas=canvas):
+                shot["png"] = canvas.screenshot()
+                return _not_blank(shot["png"])[0]
+
+            ok = _wait_for(rendered, RENDER_TIMEOUT)
+            (screenshot_dir / f"canvas{i}.png").write_bytes(shot["png"])
+            _, distinct, covered = _not_blank(shot["png"])
+            assert ok, (f"view {i} of {notebook} looks blank: {distinct} colours, "
+                        f"{covered:.1%} of the pixels off the background")
+
+        # 4: a slider beside a view changes the picture
+        found = page.evaluate(lablib.JS_FIND_SLIDER)
+        assert found["found"], (
+            f"{notebook}: no slider shares an ipywidgets box with a view; put them in one box, "
+            "e.g. ipywidgets.VBox([slider, view.widget]) (see geomlib/viewer.py)")
+        box_canvases = page.locator("[data-geomlib-box] .geomlib-canvas")
+        before = [box_canvases.nth(i).screenshot() for i in range(box_canvases.count())]
+        handle = page.locator("[data-geomlib-slider] .noUi-handle").first
+        handle.scroll_into_view_if_needed()
+        handle.focus()
+        at_max = found["now"] is not None and found["max"] is not None and found["now"] >= found["max"]
+        page.keyboard.press("Home" if at_max else "End")
+        moved = {}
+
+        def changed():
+            moved["after"] = [box_canvases.nth(i).screenshot() for i in range(box_canvases.count())]
+            moved["fraction"] = max(lablib.changed_fraction(a, b) for a, b in zip(before, moved["after"]))
+            return moved["fraction"] > 0.005
+
+        ok = _wait_for(changed, RENDER_TIMEOUT, interval=0.5)
+        for i, png in enumerate(moved["after"]):
+            (screenshot_dir / f"slider_after{i}.png").write_bytes(png)
+        page.screenshot(path=str(screenshot_dir / "page_after_slider.png"))
+        assert ok, (f"{notebook}: moving the slider '{found['description']}' changed "
+                    f"{moved['fraction']:.2%} of the view's pixels")
+        state = page.evaluate(lablib.JS_STATE)
+        assert not state["errors"], f"the slider callback raised:\n{_format_errors(state['errors'])}"
+
+        # 5: linked cameras turn together
+        rows = page.locator(".geomlib-row")
+        for r in range(rows.count()):
+            views = rows.nth(r).locator(".geomlib-canvas")
+            if views.count() < 2:
+                continue
+            first, second = views.nth(0), views.nth(1)
+            first.scroll_into_view_if_needed()
+            before = second.screenshot()
+            box = first.bounding_box()
+            x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+            page.mouse.move(x, y)
+            page.mouse.down()
+            page.mouse.move(x + 90, y + 40, steps=10)
+            page.mouse.up()
+            ok = _wait_for(lambda: lablib.changed_fraction(before, second.screenshot()) > 0.005, RENDER_TIMEOUT)
+            (screenshot_dir / f"row{r}_linked.png").write_bytes(second.screenshot())
+            assert ok, f"{notebook}: orbiting the first view of side_by_side row {r} did not turn the second"
+    finally:
+        (screenshot_dir / "console.txt").write_text("\n".join(console))
+        lablib.shutdown_kernel(page)
+        page.close()
