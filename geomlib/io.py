@@ -181,7 +181,7 @@ def _obj_fast(data):
     vbefore = None
     if len(idx) and idx.min() < 0:
         vbefore = np.searchsorted(v_idx, f_idx)  # v lines above each face line
-    return V, idx, sizes, lines, vbefore
+    return V, idx, sizes, lines, vbefore, v_idx + 1
 
 
 # --------------------------------------------------------------------------
@@ -189,7 +189,7 @@ def _obj_fast(data):
 
 
 def _obj_slow(data, where):
-    verts, idx, sizes, lines, vbefore = [], [], [], [], []
+    verts, vlines, idx, sizes, lines, vbefore = [], [], [], [], [], []
     pending = b""
     pending_line = 0
     for lineno, raw in enumerate(data.split(b"\n"), start=1):
@@ -217,6 +217,7 @@ def _obj_slow(data, where):
             try:
                 verts.append([float(w) for w in words[1:4]])
                 [float(w) for w in words[4:]]
+                vlines.append(lineno)
             except ValueError:
                 raise MeshError(f"{where}: line {lineno}: vertex coordinates are not numbers: {_show(raw)}") from None
         elif key == b"f":
@@ -243,7 +244,7 @@ def _obj_slow(data, where):
             )
     V = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
     return (V, np.asarray(idx, np.int64), np.asarray(sizes, np.int64),
-            np.asarray(lines, np.int64), np.asarray(vbefore, np.int64))
+            np.asarray(lines, np.int64), np.asarray(vbefore, np.int64), np.asarray(vlines, np.int64))
 
 
 # --------------------------------------------------------------------------
@@ -319,15 +320,11 @@ def _read_obj(data, where):
     if not data.endswith(b"\n"):
         data += b"\n"
     try:
-        V, idx, sizes, lines, vbefore = _obj_fast(data)
+        V, idx, sizes, lines, vbefore, vlines = _obj_fast(data)
     except _Fallback:
-        V, idx, sizes, lines, vbefore = _obj_slow(data, where)
-    else:
-        if len(V) == 0 and len(sizes) == 0:
-            # nothing recognised: let the line-by-line reader say what is there
-            V, idx, sizes, lines, vbefore = _obj_slow(data, where)
+        V, idx, sizes, lines, vbefore, vlines = _obj_slow(data, where)
     _no_mesh_check(where, len(V), len(sizes))
-    V = _check_vertices(V, where, lines_of=None)
+    V = _check_vertices(V, where, lines_of=vlines)
     F = _build_faces(where, len(V), idx, sizes, lines, one_based=True, vbefore=vbefore)
     return V, F
 
@@ -439,6 +436,8 @@ def _read_trimesh(path, where, ext):
         raise MeshError(f"{where}: cannot read as {ext[1:].upper()}: {type(exc).__name__}: {exc}") from None
     if isinstance(loaded, trimesh.Scene):
         geoms = list(loaded.geometry.values())
+        if not geoms:
+            raise MeshError(f"{where}: cannot read as {ext[1:].upper()}: no mesh found in the file")
         if len(geoms) != 1:
             raise MeshError(f"{where}: the file holds {len(geoms)} objects; save one mesh per file")
         loaded = geoms[0]
@@ -544,14 +543,32 @@ def _write_off(path, V, F):
         fh.write(ftext)
 
 
+def _write_ply(path, V, F):
+    n, m = len(V), len(F)
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {n}\nproperty double x\nproperty double y\nproperty double z\n"
+        f"element face {m}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    faces = np.empty(m, dtype=[("k", "u1"), ("idx", "<i4", (3,))])
+    faces["k"] = 3
+    if m and F.max() > np.iinfo(np.int32).max:
+        raise MeshError(f"{path}: PLY stores indices as int32; {n} vertices are too many")
+    faces["idx"] = F
+    with open(path, "wb") as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(np.ascontiguousarray(V, dtype="<f8").tobytes())
+        fh.write(faces.tobytes())
+
+
 def save_mesh(path, V, F):
     """Write a triangle mesh; the format is chosen by the extension.
 
     * ``.obj``, ``.off``: written by this module with ``%.17g``, so every
       float64 coordinate reads back bit for bit; OBJ indices 1-based, OFF
       0-based.
-    * ``.ply``: binary little-endian PLY through trimesh, float64 vertices,
-      exact round trip.
+    * ``.ply``: binary little-endian PLY written by this module, vertices as
+      ``double``, faces as ``uchar``-counted ``int`` lists: exact round trip.
     * ``.stl``: binary STL through trimesh; STL stores float32 corners per
       facet, so coordinates are rounded to float32 and a reload gives three
       vertices per facet (see :func:`load_mesh`).
@@ -582,15 +599,13 @@ def save_mesh(path, V, F):
             _write_obj(where, V, F)
         elif ext == ".off":
             _write_off(where, V, F)
+        elif ext == ".ply":
+            _write_ply(where, V, F)
         else:
             import trimesh
 
             mesh = trimesh.Trimesh(vertices=V, faces=F, process=False, validate=False)
-            if ext == ".ply":
-                blob = trimesh.exchange.ply.export_ply(mesh, encoding="binary", vertex_normal=False)
-            else:
-                blob = trimesh.exchange.stl.export_stl(mesh)
             with open(where, "wb") as fh:
-                fh.write(blob)
+                fh.write(trimesh.exchange.stl.export_stl(mesh))
     except OSError as exc:
         raise MeshError(f"{where}: cannot write the file: {exc.strerror or exc}") from None
