@@ -103,7 +103,17 @@ def bounding_box_diagonal(V):
 def _cross_faces(V, F):
     """Per-face cross products ``(v1 - v0) x (v2 - v0)`` = 2 A n, (m, 3)."""
     P0 = V[F[:, 0]]
-    return np.cross(V[F[:, 1]] - P0, V[F[:, 2]] - P0)
+    a = V[F[:, 1]] - P0
+    b = V[F[:, 2]] - P0
+    N = np.empty_like(a)
+    N[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    N[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    N[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return N
+
+
+def _norms(X):
+    return np.sqrt(X[:, 0] * X[:, 0] + X[:, 1] * X[:, 1] + X[:, 2] * X[:, 2])
 
 
 def surface_area(V, F):
@@ -197,8 +207,8 @@ def dihedral_angles(V, F, edges=None):
     return E, _bend_angles(V, F, E, f1, f2)
 
 
-def _bend_angles(V, F, E, f1, f2):
-    N = _cross_faces(V, F)
+def _bend_angles(V, F, E, f1, f2, N=None):
+    N = _cross_faces(V, F) if N is None else N
     n1, n2 = N[f1], N[f2]
     angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1),
                                   np.einsum("ij,ij->i", n1, n2)))
@@ -423,7 +433,7 @@ class MeshComparison:
         self.closed = len(boundary) == 0 and len(other) == 0
         self._N_clean = _cross_faces(self.V_clean, self.F)
         self.area_clean = 0.5 * float(np.linalg.norm(self._N_clean, axis=1).sum())
-        self.volume_clean = enclosed_volume(self.V_clean, self.F) if self.closed else float("nan")
+        self.volume_clean = _volume(self.V_clean, self.F, self._N_clean) if self.closed else float("nan")
         self.bend_clean = _bend_angles(self.V_clean, self.F, E, f1, f2)
         self.sharp = np.flatnonzero(np.abs(self.bend_clean) > self.sharp_angle)
         self._index_clean = None
@@ -495,7 +505,7 @@ class MeshComparison:
         if not self.closed:
             raise MeshError("the volume change is defined for closed meshes only; this mesh has "
                             "boundary or non-manifold edges")
-        return (enclosed_volume(V, self.F) - self.volume_clean) / abs(self.volume_clean)
+        return (_volume(V, self.F, _cross_faces(V, self.F)) - self.volume_clean) / abs(self.volume_clean)
 
     # -- all at once -----------------------------------------------------------
 
@@ -513,25 +523,44 @@ class MeshComparison:
         mesh has none).
         """
         V = self._check(V)
-        angles = self.face_normal_angles(V)
-        out = {"rms": self.vertex_rms(V)}
+        N = _cross_faces(V, self.F)
+        angles = _normal_angles(N, self._N_clean)
+        D = V - self.V_clean
+        out = {"rms": float(np.sqrt(np.mean(D * D) * 3)) / self.diagonal}
         if hausdorff:
             out["hausdorff"] = self.hausdorff(V)
         out["normal_mean"] = float(angles.mean())
         out["normal_p95"] = float(np.percentile(angles, 95))
-        out["area_change"] = self.area_change(V)
-        out["volume_change"] = self.volume_change(V) if self.closed else float("nan")
-        out["sharp_edge_error"] = self.sharp_edge_error(V)
+        out["area_change"] = 0.5 * float(_norms(N).sum()) / self.area_clean - 1.0
+        if self.closed:
+            out["volume_change"] = (_volume(V, self.F, N) - self.volume_clean) / abs(self.volume_clean)
+        else:
+            out["volume_change"] = float("nan")
+        if len(self.sharp):
+            s = self.sharp
+            bend = _bend_angles(V, self.F, self.edges[s], self._f1[s], self._f2[s], N)
+            out["sharp_edge_error"] = float(np.mean(np.abs(bend - self.bend_clean[s])))
+        else:
+            out["sharp_edge_error"] = float("nan")
         return out
+
+
+def _volume(V, F, N):
+    """Enclosed volume from the face cross products N:
+    ``v0 . ((v1 - v0) x (v2 - v0)) = v0 . (v1 x v2)``, summed, over 6."""
+    return float((V[F[:, 0]] * N).sum()) / 6.0
 
 
 def _normal_angles(N, N_clean):
     """Angles (degrees) between the rows of two arrays of (unnormalised)
     normals; rows with a zero vector (degenerate faces) count as 90."""
-    cross = np.linalg.norm(np.cross(N, N_clean), axis=1)
-    dot = np.einsum("ij,ij->i", N, N_clean)
-    angle = np.degrees(np.arctan2(cross, dot))
-    zero = (np.einsum("ij,ij->i", N, N) == 0) | (np.einsum("ij,ij->i", N_clean, N_clean) == 0)
+    X = np.empty_like(N)
+    X[:, 0] = N[:, 1] * N_clean[:, 2] - N[:, 2] * N_clean[:, 1]
+    X[:, 1] = N[:, 2] * N_clean[:, 0] - N[:, 0] * N_clean[:, 2]
+    X[:, 2] = N[:, 0] * N_clean[:, 1] - N[:, 1] * N_clean[:, 0]
+    dot = N[:, 0] * N_clean[:, 0] + N[:, 1] * N_clean[:, 1] + N[:, 2] * N_clean[:, 2]
+    angle = np.degrees(np.arctan2(_norms(X), dot))
+    zero = (_norms(N) == 0) | (_norms(N_clean) == 0)
     angle[zero] = 90.0
     return angle
 
@@ -691,3 +720,230 @@ def denoising_metrics(V, V_clean, F, sharp_angle=SHARP_ANGLE,
                       samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
     """Every metric of V against the clean mesh, as a dict (see :meth:`MeshComparison.evaluate`)."""
     return MeshComparison(V_clean, F, sharp_angle, samples_per_face, seed).evaluate(V)
+
+
+# ----------------------------------------------------------------------------
+# a sweep of Laplacian smoothing over noise levels, schemes, steps, iterations
+# ----------------------------------------------------------------------------
+
+#: (method, weights) pairs compared by :func:`smoothing_sweep`.
+SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"),
+           ("implicit", "uniform"), ("implicit", "cotan"))
+
+#: Explicit steps of the sweep, as fractions of the stability limit
+#: ``2 / lambda_max`` of the mesh being smoothed (below 1 is stable).
+EXPLICIT_FRACTIONS = (0.1, 0.25, 0.5, 0.9)
+
+#: Implicit steps of the sweep, scale-free (see :func:`scale_free_step`).
+IMPLICIT_STEPS = (0.1, 0.3, 1.0, 3.0)
+
+#: Iteration counts at which the sweep measures every run.
+SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
+
+#: Metric keys recorded by the sweep (all of :meth:`MeshComparison.evaluate`
+#: except the Hausdorff estimate, which is measured for chosen results only).
+SWEEP_KEYS = ("rms", "normal_mean", "normal_p95", "area_change", "volume_change",
+              "sharp_edge_error")
+
+
+def mean_edge_length(V, F):
+    """Mean length of the mesh's edges, each counted once (length units)."""
+    V = _as_vertices(V)
+    F = _as_faces(F, len(V))
+    E = np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    E = np.unique(E, axis=0)
+    return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())
+
+
+def scale_free_step(V, F, method, weights, value):
+    """The smoothing step (units of :mod:`geomlib.smoothing`) for a scale-free ``value``.
+
+    * explicit: ``value`` is a fraction of the stability limit of this mesh,
+      ``step = value * explicit_step_limit(V, F, weights)``.
+    * implicit, uniform weights: ``Delta`` is dimensionless, ``step = value``.
+    * implicit, cotangent weights: ``step = value * h^2 / 4`` with ``h`` the
+      mean edge length of this mesh. On an equilateral mesh the cotangent
+      Laplacian is the uniform one divided by ``h^2 / 4``, so the same
+      ``value`` diffuses by the same amount with either weights, at any scale.
+
+    For the cotangent operator of a *noisy* mesh the explicit limit collapses
+    (noise makes obtuse triangles with large cotangents), which is why the
+    implicit step is not tied to it.
+    """
+    if method == "explicit":
+        from .smoothing import explicit_step_limit
+
+        return float(value) * explicit_step_limit(V, F, weights)
+    if method != "implicit":
+        raise MeshError(f"method must be 'explicit' or 'implicit', not {method!r}")
+    if weights == "uniform":
+        return float(value)
+    if weights == "cotan":
+        return float(value) * mean_edge_length(V, F) ** 2 / 4.0
+    raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
+
+
+class SmoothingSweep:
+    """Results of :func:`smoothing_sweep`: every metric for every setting.
+
+    Attributes
+    ----------
+    sigmas : (a,) float64
+        Noise levels (fractions of the bounding-box diagonal).
+    schemes : list of (method, weights)
+    step_values : dict method -> tuple
+        The scale-free step values (:func:`scale_free_step`).
+    steps : (a, s, b) float64
+        The actual step used for noise level i, scheme j, step value k.
+    iterations : (c,) int64
+    values : dict key -> (a, s, b, c) float64
+        ``values["rms"][i, j, k, l]``: the metric after ``iterations[l]``
+        iterations. NaN where a run stopped early (divergence).
+    noisy : dict key -> (a,) float64
+        The metrics of the noisy input itself.
+    seconds : float
+        Wall-clock time of the sweep.
+    """
+
+    def __init__(self, sigmas, schemes, step_values, iterations):
+        self.sigmas = np.asarray(sigmas, dtype=np.float64)
+        self.schemes = list(schemes)
+        self.step_values = dict(step_values)
+        self.iterations = np.asarray(iterations, dtype=np.int64)
+        b = max(len(v) for v in self.step_values.values())
+        shape = (len(self.sigmas), len(self.schemes), b, len(self.iterations))
+        self.steps = np.full(shape[:3], np.nan)
+        self.values = {key: np.full(shape, np.nan) for key in SWEEP_KEYS}
+        self.noisy = {key: np.full(len(self.sigmas), np.nan) for key in SWEEP_KEYS}
+        self.seconds = float("nan")
+
+    def best(self, i, key="rms", schemes=None):
+        """The setting with the smallest ``key`` at noise level ``i``.
+
+        Parameters
+        ----------
+        i : int
+            Index into ``sigmas``.
+        key : str
+            A metric of ``values`` (smaller is better; for signed changes the
+            absolute value counts).
+        schemes : list of (method, weights), optional
+            Restrict the search to these schemes.
+
+        Returns
+        -------
+        dict with ``method``, ``weights``, ``step_value``, ``step``,
+        ``iterations``, the metrics of that setting (every key of ``values``)
+        and ``index`` (j, k, l) into ``values``.
+        """
+        allowed = [j for j, s in enumerate(self.schemes) if schemes is None or s in schemes]
+        block = np.abs(self.values[key][i])
+        mask = np.full(block.shape, np.inf)
+        mask[allowed] = 0.0
+        block = np.where(np.isnan(block), np.inf, block) + mask
+        j, k, l = np.unravel_index(int(np.argmin(block)), block.shape)
+        method, weights = self.schemes[j]
+        out = {"method": method, "weights": weights,
+               "step_value": self.step_values[method][k], "step": float(self.steps[i, j, k]),
+               "iterations": int(self.iterations[l]), "index": (int(j), int(k), int(l))}
+        out.update({name: float(v[i, j, k, l]) for name, v in self.values.items()})
+        return out
+
+
+def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fractions=EXPLICIT_FRACTIONS,
+                    implicit_steps=IMPLICIT_STEPS, iterations=SWEEP_ITERATIONS, direction="isotropic",
+                    comparison=None, progress=True):
+    """Add noise at each level, smooth it with every scheme, step and iteration count, measure.
+
+    For every noise level ``sigma`` (a fraction of the bounding-box
+    diagonal) the noisy mesh is ``add_noise(V_clean, F, sigma, seed,
+    direction)`` (the same seed at every level: the same noise pattern,
+    growing). Every scheme ``(method, weights)`` then smooths it with every
+    step value (:func:`scale_free_step`) for ``max(iterations)`` iterations,
+    and the mesh is measured against the clean one after each count in
+    ``iterations`` (:meth:`MeshComparison.evaluate` without the Hausdorff
+    estimate). One run per (noise level, scheme, step) covers all iteration
+    counts; implicit runs factorise ``M - step C`` once per (noisy mesh,
+    weights, step) and reuse it (:class:`geomlib.smoothing.ImplicitSmoother`).
+    The operators are those of the noisy mesh, built once per run and kept
+    fixed (as in :func:`geomlib.explicit_smoothing` and
+    :func:`geomlib.implicit_smoothing`).
+
+    Parameters
+    ----------
+    V_clean : (n, 3) float64
+    F : (m, 3) int64
+    sigmas : sequence of float
+    seed : int
+    schemes : sequence of (method, weights)
+    explicit_fractions, implicit_steps : sequence of float
+        Scale-free step values of the explicit and implicit runs.
+    iterations : sequence of int
+        Increasing iteration counts at which to measure.
+    direction : "isotropic" or "normal"
+        Of the noise (:func:`geomlib.add_noise`).
+    comparison : MeshComparison, optional
+        Reuse one built for (V_clean, F).
+    progress : bool
+        A tqdm.auto progress bar over the runs.
+
+    Returns
+    -------
+    SmoothingSweep
+    """
+    import time
+    import warnings
+
+    from .errors import MeshWarning
+    from .noise import add_noise
+    from .smoothing import ImplicitSmoother, explicit_smoothing
+
+    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    iterations = np.asarray(sorted(set(int(k) for k in iterations)), dtype=np.int64)
+    if len(iterations) == 0 or iterations[0] < 1:
+        raise MeshError("iterations must be positive whole numbers")
+    step_values = {"explicit": tuple(explicit_fractions), "implicit": tuple(implicit_steps)}
+    for method, weights in schemes:
+        if method not in step_values or weights not in ("uniform", "cotan"):
+            raise MeshError(f"unknown scheme ({method!r}, {weights!r}); methods are 'explicit' and "
+                            "'implicit', weights 'uniform' and 'cotan'")
+    out = SmoothingSweep(sigmas, schemes, step_values, iterations)
+    where = {int(k): l for l, k in enumerate(iterations)}
+    last = int(iterations[-1])
+    runs = sum(len(step_values[m]) for m, _ in schemes) * len(out.sigmas)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=runs, desc="smoothing sweep")
+    start = time.perf_counter()
+    try:
+        for i, sigma in enumerate(out.sigmas):
+            Vn = add_noise(C.V_clean, C.F, sigma, seed, direction=direction)
+            for key, value in C.evaluate(Vn, hausdorff=False).items():
+                out.noisy[key][i] = value
+            for j, (method, weights) in enumerate(schemes):
+                smoother = ImplicitSmoother(Vn, C.F, weights) if method == "implicit" else None
+                for k, value in enumerate(step_values[method]):
+                    step = scale_free_step(Vn, C.F, method, weights, value)
+                    out.steps[i, j, k] = step
+
+                    def record(it, P, i=i, j=j, k=k):
+                        if it in where:
+                            for name, v in C.evaluate(P, hausdorff=False).items():
+                                out.values[name][i, j, k, where[it]] = v
+
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", MeshWarning)
+                        if method == "explicit":
+                            explicit_smoothing(Vn, C.F, step, last, weights, callback=record,
+                                               on_failure="stop", progress=False)
+                        else:
+                            smoother.smooth(step, last, callback=record, progress=False)
+                    if bar is not None:
+                        bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    out.seconds = time.perf_counter() - start
+    return out
