@@ -40,6 +40,7 @@ _EXPORTS = {
     "one_ring": "topology",
     "euler_characteristic": "topology",
     "connected_components": "topology",
+    "vertex_face_adjacency": "topology",
     # Laplacians and curvature
     "laplacian": "laplace",
     "cotangent_weights": "laplace",

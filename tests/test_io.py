@@ -84,6 +84,11 @@ def test_obj_vertex_extras_crlf_continuation_and_blanks(tmp_path):
     assert np.array_equal(F, [[0, 1, 2]])
 
 
+def test_obj_inline_comments(tmp_path):
+    V, F = load_quiet(write(tmp_path, "c.obj", SQUARE_V + "f 1 2 3 # first\nf 1 3 4#second\n"))
+    assert np.array_equal(F, [[0, 1, 2], [0, 2, 3]])
+
+
 def test_obj_without_final_newline_and_tabs(tmp_path):
     V, F = load_quiet(write(tmp_path, "t.obj", "v\t0 0 0\nv 1\t0 0\nv 0 1 0\nf\t1 2 3"))
     assert len(V) == 3 and np.array_equal(F, [[0, 1, 2]])
@@ -207,6 +212,16 @@ def test_missing_file(tmp_path):
 def test_directory(tmp_path):
     (tmp_path / "dir.obj").mkdir()
     expect(tmp_path / "dir.obj", r": is a directory, not a mesh file$")
+
+
+def test_unreadable_file(tmp_path, monkeypatch):
+    path = write(tmp_path, "locked.obj", SQUARE_V + "f 1 2 3\n")
+
+    def refuse(self):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(Path, "read_bytes", refuse)
+    expect(path, r"locked\.obj: cannot read the file: Permission denied$")
 
 
 def test_unknown_extension(tmp_path):

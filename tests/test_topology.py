@@ -17,8 +17,8 @@ from geomlib import (
     load_mesh,
     one_ring,
     valence,
+    vertex_face_adjacency,
 )
-from geomlib.topology import vertex_face_adjacency
 
 COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
 needs_course = pytest.mark.skipif(not COURSE.is_dir(), reason="course meshes not present")
