@@ -77,6 +77,9 @@ _OBJ_IGNORED = {
 }
 
 
+_HUGE = 2**62  # larger indices cannot be a vertex of any file (and would overflow int64)
+
+
 class _Fallback(Exception):
     """The vectorised OBJ reader met something unusual; reread line by line."""
 
@@ -175,8 +178,8 @@ def _obj_fast(data):
         fbuf = re.sub(rb"/\S*", b"", fbuf)
     sizes = _tokens_per_line(fbuf)
     idx = _fromstring(fbuf, np.int64)
-    if len(idx) != sizes.sum():
-        raise _Fallback
+    if len(idx) != sizes.sum() or (len(idx) and (idx.max() > _HUGE or idx.min() < -_HUGE)):
+        raise _Fallback  # (np.fromstring saturates huge integers instead of failing)
     lines = f_idx + 1
     vbefore = None
     if len(idx) and idx.min() < 0:
@@ -231,6 +234,8 @@ def _obj_slow(data, where):
                 raise MeshError(
                     f"{where}: line {lineno}: face corners must be integers (v, v/vt, v//vn or v/vt/vn): {_show(raw)}"
                 ) from None
+            if any(abs(c) > _HUGE for c in face):
+                raise MeshError(f"{where}: line {lineno}: face index too large: {_show(raw)}")
             idx.extend(face)
             sizes.append(len(face))
             lines.append(lineno)
@@ -408,7 +413,10 @@ def _read_off(data, where):
             k = int(w[0])
             if k < 0 or len(w) < 1 + k:
                 raise ValueError
-            idx.extend(int(x) for x in w[1:1 + k])
+            face = [int(x) for x in w[1:1 + k]]
+            if any(abs(c) > _HUGE for c in face):
+                raise ValueError
+            idx.extend(face)
         except ValueError:
             raise MeshError(f"{where}: line {ln}: a face is 'k i0 ... ik-1' with k integer indices, "
                             f"found {_show(b' '.join(w))}") from None

@@ -290,6 +290,11 @@ def test_malformed_face_line(tmp_path):
     expect(write(tmp_path, "floatf.obj", SQUARE_V + "f 1 2 3.5\n"), r": line 5: face corners must be integers")
 
 
+def test_face_index_too_large(tmp_path):
+    expect(write(tmp_path, "big.obj", SQUARE_V + "f 1 2 123456789012345678901234567890\n"),
+           r": line 5: face index too large: 'f 1 2 123456789012345678901234567890'$")
+
+
 def test_face_with_two_vertices(tmp_path):
     expect(write(tmp_path, "two.obj", SQUARE_V + "f 1 2 3\nf 1 2\n"),
            r": line 6: a face needs at least 3 vertex indices, found 2$")
