@@ -475,7 +475,8 @@ class ParametricSurface:
     def principal_directions(self, u, v):
         """Principal directions at (u, v): ((phi1, d1), (phi2, d2)) for k1 >= k2.
 
-        phi1 = atan2(2B, A - C) / 2 in the frame (p_u/|p_u|, w), phi2 = phi1 + pi/2;
+        phi1 = atan2(2B, A - C) / 2 in the frame (p_u/|p_u|, w), phi2 = phi1 -+ pi/2
+        (both angles in (-pi/2, pi/2]);
         d1, d2 are unit 3-vectors (3x1 sympy matrices). At an umbilic
         (A = C, B = 0) every direction is principal and phi1 = 0 is returned.
         """
@@ -491,9 +492,18 @@ class ParametricSurface:
                 phi1 = sp.Piecewise((sp.Integer(0), diff >= 0), (sp.pi / 2, True))
         else:
             phi1 = _tidy(sp.atan2(2 * B, diff) / 2)
+        # the second direction at phi1 -+ pi/2, whichever lies in (-pi/2, pi/2]
+        if isinstance(phi1, sp.Piecewise):
+            phi2 = sp.Piecewise((sp.pi / 2, diff >= 0), (sp.Integer(0), True))
+        else:
+            nonpositive = sp.simplify(phi1) <= 0
+            if nonpositive in (sp.true, sp.false):
+                phi2 = phi1 + sp.pi / 2 if nonpositive == sp.true else phi1 - sp.pi / 2
+            else:
+                phi2 = sp.Piecewise((phi1 + sp.pi / 2, nonpositive), (phi1 - sp.pi / 2, True))
         e1, w = self.frame(u, v)
         out = []
-        for phi in (phi1, phi1 + sp.pi / 2):
+        for phi in (phi1, phi2):
             d = (sp.cos(phi) * e1 + sp.sin(phi) * w).applyfunc(_tidy)
             out.append((_tidy(phi), d))
         return tuple(out)
