@@ -197,7 +197,8 @@ class MeshReport:
     indices with the smaller index first. ``problems`` lists, in words, what
     departs from a clean closed or open 2-manifold, with what still works;
     ``ok`` is True when it is empty. Boundaries are a property, not a problem
-    (an open surface is a valid input everywhere in geomlib).
+    (an open surface is a valid input everywhere in geomlib): they appear in
+    ``notes``.
     """
 
     n_vertices: int
@@ -216,6 +217,7 @@ class MeshReport:
     euler_characteristic: int
     genus: int | None
     problems: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
 
     # derived properties -------------------------------------------------
     @property
@@ -265,7 +267,7 @@ class MeshReport:
             ("connected components", f"{self.n_components}"
              + (f" (faces per component: {format_indices(self.component_sizes)})" if self.n_components > 1 else "")),
             ("closed", yes[self.is_closed]),
-            ("boundary", f"{len(self.boundary_edges)} edges in {len(loops)} loops"
+            ("boundary", f"{_count(self.boundary_edges, 'edge')} in {_count(loops, 'loop')}"
              + (f" of {format_indices(loops)} edges" if loops else "")),
             ("manifold", yes[self.is_manifold]),
             ("consistently oriented", yes[self.is_oriented]),
@@ -286,6 +288,7 @@ class MeshReport:
             lines += [f"  - {p}" for p in self.problems]
         else:
             lines.append("No problems found.")
+        lines += [f"Note: {note}" for note in self.notes]
         return "\n".join(lines)
 
     def __repr__(self):
@@ -304,7 +307,14 @@ class MeshReport:
             tail = f"<p><b>Problems (and what still works):</b></p><ul>{items}</ul>"
         else:
             tail = "<p>No problems found.</p>"
+        tail += "".join(f"<p>Note: {html.escape(note)}</p>" for note in self.notes)
         return f"<div><b>MeshReport</b><table>{rows}</table>{tail}</div>"
+
+
+def _count(items, singular, plural=None):
+    """'1 edge', '3 edges': a count with its noun in the right number."""
+    k = len(items)
+    return f"{k} {singular if k == 1 else (plural or singular + 's')}"
 
 
 def _listing(idx):
@@ -401,20 +411,20 @@ def check_mesh(V, F):
     problems = []
     if len(zero):
         problems.append(
-            f"{len(zero)} zero-area faces ({format_indices(zero)}): their cotangent weights and normals are "
+            f"{_count(zero, 'zero-area face')} ({format_indices(zero)}): their cotangent weights and normals are "
             "undefined; the uniform Laplacian, valence and topology still work")
     if len(nm_edges):
         problems.append(
-            f"{len(nm_edges)} non-manifold edges used by more than two faces ({_edges_text(nm_edges)}): "
+            f"{_count(nm_edges, 'non-manifold edge')} used by more than two faces ({_edges_text(nm_edges)}): "
             "Laplacians still assemble, but one_ring fails at their vertices and boundary loops can be ambiguous")
     if len(nm_vertices):
         problems.append(
-            f"{len(nm_vertices)} non-manifold vertices whose faces form more than one fan ({format_indices(nm_vertices)}): "
+            f"{_count(nm_vertices, 'non-manifold vertex', 'non-manifold vertices')} whose faces form more than one fan ({format_indices(nm_vertices)}): "
             "Laplacians and curvature still compute, but one_ring fails there and the angle deficit "
             "mixes the fans; Euler characteristic and genus do not describe a surface")
     if len(inconsistent):
         problems.append(
-            f"{len(inconsistent)} edges traversed in the same direction by both faces (inconsistent orientation, "
+            f"{_count(inconsistent, 'edge')} traversed in the same direction by both faces (inconsistent orientation, "
             f"{_edges_text(inconsistent)}): signed mean curvature and normals flip "
             "between the two sides; unsigned H, K and the Laplacians still work")
     if n_comp > 1:
@@ -423,11 +433,17 @@ def check_mesh(V, F):
             "curvature and smoothing work per component")
     if len(unref):
         problems.append(
-            f"{len(unref)} unreferenced vertices ({format_indices(unref)}): they have zero area and no neighbours, "
+            f"{_count(unref, 'unreferenced vertex', 'unreferenced vertices')} ({format_indices(unref)}): they have zero area and no neighbours, "
             "so their Laplacian rows are zero and M is singular there; they are kept so that indices match the file")
     if len(dups):
         problems.append(
-            f"{len(dups)} duplicate faces ({format_indices(dups)}): areas and cotangent weights count them twice")
+            f"{_count(dups, 'duplicate face')} ({format_indices(dups)}): areas and cotangent weights count them twice")
+    notes = []
+    if len(bedges):
+        notes.append(
+            f"open surface, {_count(bedges, 'boundary edge')} in {_count(loops, 'loop')}: every geomlib function "
+            "works; each curvature function states its rule at boundary vertices, and Gauss-Bonnet needs the "
+            "boundary (geodesic curvature) term")
     return MeshReport(
         n_vertices=n,
         n_faces=m,
@@ -445,4 +461,5 @@ def check_mesh(V, F):
         euler_characteristic=chi,
         genus=genus,
         problems=problems,
+        notes=notes,
     )

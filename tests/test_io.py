@@ -114,7 +114,7 @@ def test_fast_and_line_by_line_readers_agree(tmp_path):
 
 def test_unreferenced_vertex_is_kept_with_a_warning(tmp_path):
     path = write(tmp_path, "extra.obj", SQUARE_V + "v 5 5 5\nf 1 2 3\nf 1 3 4\n")
-    with pytest.warns(MeshWarning, match=r"extra\.obj: 1 unreferenced vertices \(4\)") as rec:
+    with pytest.warns(MeshWarning, match=r"extra\.obj: 1 unreferenced vertex \(4\)") as rec:
         V, F = load_mesh(path)
     assert len(rec) == 1  # one warning summarising everything
     assert len(V) == 5 and np.array_equal(V[4], [5, 5, 5])
@@ -126,7 +126,7 @@ def test_one_warning_for_several_problems(tmp_path):
         load_mesh(write(tmp_path, "many.obj", text))
     assert len(rec) == 1
     msg = str(rec[0].message)
-    assert "1 zero-area faces (3)" in msg and "1 unreferenced vertices (4)" in msg and "1 duplicate faces (2)" in msg
+    assert "1 zero-area face (3)" in msg and "1 unreferenced vertex (4)" in msg and "1 duplicate face (2)" in msg
 
 
 def test_report_true_returns_the_report_without_warning(tmp_path):

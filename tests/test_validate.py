@@ -132,6 +132,8 @@ def test_open_disk_is_not_a_problem():
     assert r.boundary_loop_lengths == [4]
     assert np.array_equal(r.boundary_loops[0], [1, 2, 3, 4])
     assert len(r.boundary_edges) == 4
+    assert "Note: open surface, 4 boundary edges in 1 loop" in str(r)
+    assert "Note: open surface" in r._repr_html_()
 
 
 def test_zero_area_face():
@@ -139,7 +141,7 @@ def test_zero_area_face():
     F = np.array([[0, 1, 3], [0, 2, 1]])  # face 1 is collinear
     r = check_mesh(V, F)
     assert np.array_equal(r.zero_area_faces, [1])
-    assert any("1 zero-area faces (1)" in p and "still work" in p for p in r.problems)
+    assert any("1 zero-area face (1)" in p and "still work" in p for p in r.problems)
 
 
 def test_zero_area_is_scale_free():
@@ -157,7 +159,7 @@ def test_non_manifold_edge():
     r = check_mesh(V, F)
     assert np.array_equal(r.non_manifold_edges, [[0, 1]])
     assert not r.is_manifold and r.genus is None
-    assert any("1 non-manifold edges used by more than two faces ((0, 1))" in p for p in r.problems)
+    assert any("1 non-manifold edge used by more than two faces ((0, 1))" in p for p in r.problems)
 
 
 def test_non_manifold_vertex_two_cones():
@@ -169,7 +171,7 @@ def test_non_manifold_vertex_two_cones():
     assert len(r.non_manifold_edges) == 0 and r.is_closed and r.is_oriented
     assert r.euler_characteristic == 3  # 7 - 12 + 8: two spheres (2 + 2) glued at a point (-1)
     assert r.genus is None
-    assert any("1 non-manifold vertices" in p and "(0)" in p for p in r.problems)
+    assert any("1 non-manifold vertex" in p and "(0)" in p for p in r.problems)
 
 
 def test_non_manifold_vertex_bow_tie_and_general_path():
@@ -217,8 +219,8 @@ def test_components_unreferenced_and_duplicates():
     assert r.euler_characteristic == 8 - 12 + 9  # vertex 8 not counted
     text = " ".join(r.problems)
     assert "2 connected components" in text
-    assert "1 unreferenced vertices (8)" in text
-    assert "1 duplicate faces (8)" in text
+    assert "1 unreferenced vertex (8)" in text
+    assert "1 duplicate face (8)" in text
 
 
 def test_check_mesh_does_not_alter_input():
@@ -244,7 +246,7 @@ def test_report_text_and_html():
     html = r._repr_html_()
     assert html.startswith("<div>") and "<table>" in html and "unreferenced vertices" in html
     assert "MeshReport(n_vertices=5, n_faces=4" in repr(r)
-    assert r.summary().startswith("1 unreferenced vertices (4)")
+    assert r.summary().startswith("1 unreferenced vertex (4)")
 
 
 @needs_course
