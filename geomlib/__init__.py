@@ -52,6 +52,10 @@ _EXPORTS = {
     # spectral
     "eigenbasis": "spectral",
     "spectral_reconstruction": "spectral",
+    "spectral_basis": "spectral",
+    "SpectralBasis": "spectral",
+    "spectral_cache_dir": "spectral",
+    "clear_spectral_cache": "spectral",
     # smoothing
     "explicit_smoothing": "smoothing",
     "implicit_smoothing": "smoothing",
