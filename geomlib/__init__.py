@@ -60,6 +60,8 @@ _EXPORTS = {
     "explicit_smoothing": "smoothing",
     "implicit_smoothing": "smoothing",
     "explicit_step_limit": "smoothing",
+    "highest_frequency_mode": "smoothing",
+    "ImplicitSmoother": "smoothing",
     # noise and evaluation
     "add_noise": "noise",
     "bounding_box_diagonal": "metrics",

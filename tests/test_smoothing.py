@@ -1,0 +1,386 @@
+"""Laws of explicit and implicit Laplacian smoothing (geomlib.smoothing)."""
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+import trimesh
+
+from geomlib import (MeshError, MeshWarning, explicit_smoothing, explicit_step_limit,
+                     implicit_smoothing, laplacian)
+from geomlib.smoothing import (ImplicitSmoother, _boundary_mask, _volume_centroid,
+                               highest_frequency_mode)
+
+COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+
+
+def icosphere(subdivisions=2, radius=1.0, centre=(0.0, 0.0, 0.0)):
+    m = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    return np.asarray(m.vertices, float) + np.asarray(centre), np.asarray(m.faces, np.int64)
+
+
+def grid(n=12, jitter=0.0, seed=0):
+    """Regular triangulated grid of [0, 1]^2 in the plane z = 0, interior vertices jittered in-plane."""
+    x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n), indexing="ij")
+    V = np.column_stack([x.ravel(), y.ravel(), np.zeros(n * n)])
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    F = np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    if jitter:
+        rng = np.random.default_rng(seed)
+        inner = ~_boundary_mask(F, len(V))
+        V[inner, :2] += jitter / n * rng.uniform(-1, 1, (inner.sum(), 2))
+    return V, F
+
+
+def tilt(V):
+    """Put the grid on the plane z = 0.3 x - 0.5 y + 2 (a rigid-free affine map)."""
+    W = V.copy()
+    W[:, 2] = 0.3 * V[:, 0] - 0.5 * V[:, 1] + 2.0
+    return W
+
+
+def plane_distance(V):
+    return np.abs(V[:, 2] - (0.3 * V[:, 0] - 0.5 * V[:, 1] + 2.0)).max()
+
+
+# ---------------------------------------------------------------------------
+# a plane stays planar
+
+@pytest.mark.parametrize("weights", ["cotan", "uniform"])
+@pytest.mark.parametrize("boundary", ["fixed", "free"])
+def test_plane_stays_planar(weights, boundary):
+    V, F = grid(12, jitter=0.6)
+    V = tilt(V)
+    limit = explicit_step_limit(V, F, weights, boundary=boundary)
+    P = explicit_smoothing(V, F, 0.9 * limit, 20, weights, boundary=boundary)
+    assert plane_distance(P) < 1e-12
+    assert np.abs(P - V).max() > 1e-3  # it did move (in the plane)
+    Q = implicit_smoothing(V, F, 50 * limit, 5, weights, boundary=boundary)
+    assert plane_distance(Q) < 1e-12
+
+
+def test_fixed_boundary_stays_and_free_boundary_moves():
+    V, F = grid(10, jitter=0.5)
+    b = _boundary_mask(F, len(V))
+    P = implicit_smoothing(V, F, 0.01, 3, boundary="fixed")
+    assert np.array_equal(P[b], V[b])
+    Q = implicit_smoothing(V, F, 0.01, 3, boundary="free")
+    assert np.abs(Q[b] - V[b]).max() > 1e-4
+
+
+# ---------------------------------------------------------------------------
+# a sphere stays a sphere, centred where it was
+
+@pytest.mark.parametrize("keep_volume", [False, True])
+def test_sphere_stays_sphere_centred(keep_volume):
+    centre = np.array([1.0, -2.0, 0.5])
+    V, F = icosphere(3, radius=2.0, centre=centre)
+    vol0, c0 = _volume_centroid(V, F)
+    P = implicit_smoothing(V, F, 0.05, 5, keep_volume=keep_volume)
+    r = np.linalg.norm(P - centre, axis=1)
+    assert r.std() / r.mean() < 1e-3  # still a sphere (the icosphere's own unevenness)
+    _, c = _volume_centroid(P, F)
+    assert np.abs(c - centre).max() < 1e-12
+    vol, _ = _volume_centroid(P, F)
+    if keep_volume:
+        assert abs(vol / vol0 - 1) < 1e-12
+        assert np.abs(c - c0).max() < 1e-12
+        assert abs(r.mean() / 2.0 - 1) < 1e-3
+    else:
+        assert vol < 0.8 * vol0  # heat flow shrinks the sphere
+
+
+def test_keep_volume_explicit_smoother_api():
+    V, F = icosphere(2)
+    vol0, _ = _volume_centroid(V, F)
+    P = ImplicitSmoother(V, F).smooth(0.2, 4, keep_volume=True)
+    assert abs(_volume_centroid(P, F)[0] / vol0 - 1) < 1e-12
+
+
+def test_keep_volume_on_open_mesh_is_an_error():
+    V, F = grid(6)
+    with pytest.raises(MeshError, match="closed mesh"):
+        implicit_smoothing(V, F, 0.01, 1, keep_volume=True)
+
+
+# ---------------------------------------------------------------------------
+# explicit uniform step 1 = neighbour averaging
+
+@pytest.mark.parametrize("mesh", ["sphere", "grid"])
+def test_uniform_step_one_is_neighbour_average(mesh):
+    V, F = icosphere(2) if mesh == "sphere" else grid(8, jitter=0.5)
+    if mesh == "sphere":
+        V = V + 0.02 * np.random.default_rng(1).standard_normal(V.shape)
+    P = explicit_smoothing(V, F, 1.0, 1, "uniform", boundary="free")
+    E = np.unique(np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    total = np.zeros_like(V)
+    np.add.at(total, E[:, 0], V[E[:, 1]])
+    np.add.at(total, E[:, 1], V[E[:, 0]])
+    count = np.bincount(E.ravel(), minlength=len(V))[:, None]
+    np.testing.assert_allclose(P, total / count, rtol=0, atol=1e-14)
+
+
+def test_uniform_limit_is_at_least_one():
+    for V, F in (icosphere(1), icosphere(3), grid(9, jitter=0.3)):
+        assert explicit_step_limit(V, F, "uniform") >= 1.0
+
+
+# ---------------------------------------------------------------------------
+# implicit with step -> 0 changes nothing; explicit limit laws
+
+@pytest.mark.parametrize("weights", ["cotan", "uniform"])
+def test_implicit_tiny_step_changes_nothing(weights):
+    V, F = icosphere(2)
+    V = V + 0.05 * np.random.default_rng(2).standard_normal(V.shape)
+    assert np.array_equal(implicit_smoothing(V, F, 0.0, 3, weights), V)
+    d = np.abs(implicit_smoothing(V, F, 1e-12, 3, weights) - V).max()
+    assert d < 1e-9
+    # and the change is linear in the step for small steps
+    d2 = np.abs(implicit_smoothing(V, F, 2e-12, 3, weights) - V).max()
+    assert abs(d2 / d - 2) < 1e-3
+
+
+@pytest.mark.parametrize("weights", ["cotan", "uniform"])
+@pytest.mark.parametrize("subdivisions", [2, 4])  # dense (162) and Lanczos (2562) paths
+def test_explicit_just_above_limit_grows_just_below_decays(weights, subdivisions):
+    V, F = icosphere(subdivisions)
+    V = V + 0.01 * np.random.default_rng(8).standard_normal(V.shape)  # no symmetric clusters
+    lam, e = highest_frequency_mode(V, F, weights)
+    limit = explicit_step_limit(V, F, weights)
+    assert abs(limit * lam / 2 - 1) < 1e-7
+    M, C = laplacian(V, F, weights)
+    m = M.diagonal()
+    np.testing.assert_allclose(C @ e, -lam * m * e, atol=1e-6 * lam * np.abs(m * e).max())
+    # the operator is built from the input positions, so follow the top-mode component
+    # of the input itself (a perturbation would change a cotan operator)
+    c0 = np.abs(e @ (m[:, None] * V)).max()
+    j = int(np.argmax(np.abs(e @ (m[:, None] * V))))
+    assert c0 > 1e-6
+
+    def amplitude_history(fraction):
+        amps = []
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", MeshWarning)
+            explicit_smoothing(V, F, fraction * limit, 60, weights,
+                               callback=lambda k, P: amps.append(e @ (m * P[:, j])))
+        return np.abs(np.array(amps))
+
+    above, below = amplitude_history(1.02), amplitude_history(0.98)
+    assert above[-1] > 5 * c0 and below[-1] < 0.2 * c0
+    np.testing.assert_allclose(above[1:] / above[:-1], 1.04, rtol=1e-4)
+    np.testing.assert_allclose(below[1:] / below[:-1], 0.96, rtol=1e-4)
+
+
+def test_top_mode_rate_exact():
+    V, F = icosphere(2)
+    V = V + 0.01 * np.random.default_rng(9).standard_normal(V.shape)
+    lam, e = highest_frequency_mode(V, F)
+    limit = explicit_step_limit(V, F)
+    m = laplacian(V, F)[0].diagonal()
+    amps = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        explicit_smoothing(V, F, 1.01 * limit, 10, callback=lambda k, P: amps.append(e @ (m[:, None] * P)))
+    start = e @ (m[:, None] * V)
+    ratio = np.array(amps) / np.vstack([start, amps[:-1]])
+    np.testing.assert_allclose(ratio, 1 - 1.01 * limit * lam, rtol=1e-9)
+
+
+def test_step_limit_scaling_law():
+    V, F = icosphere(3)
+    for s in (1e-3, 1.0, 250.0):
+        assert explicit_step_limit(s * V, F, "cotan") == pytest.approx(s**2 * explicit_step_limit(V, F), rel=1e-8)
+        assert explicit_step_limit(s * V, F, "uniform") == pytest.approx(explicit_step_limit(V, F, "uniform"), rel=1e-12)
+
+
+def test_step_limit_fixed_boundary_at_least_free():
+    V, F = grid(10, jitter=0.5)
+    for w in ("cotan", "uniform"):
+        assert explicit_step_limit(V, F, w, boundary="fixed") >= explicit_step_limit(V, F, w, boundary="free")
+
+
+def test_step_fraction_equals_step():
+    V, F = icosphere(2)
+    V = V + 0.02 * np.random.default_rng(3).standard_normal(V.shape)
+    limit = explicit_step_limit(V, F)
+    np.testing.assert_array_equal(explicit_smoothing(V, F, step_fraction=0.5, iterations=4),
+                                  explicit_smoothing(V, F, 0.5 * limit, 4))
+
+
+def test_lanczos_limit_agrees_with_eigsh():
+    V, F = icosphere(4)
+    V = V * np.array([1.0, 2.0, 3.0])  # an ellipsoid: no symmetric clusters
+    for w in ("cotan", "uniform"):
+        M, C = laplacian(V, F, w)
+        lam = sla.eigsh(-C, k=1, M=M.tocsc(), which="LA", tol=1e-12,
+                        v0=np.random.default_rng(0).standard_normal(len(V)),
+                        return_eigenvectors=False)[0]
+        assert explicit_step_limit(V, F, w) == pytest.approx(2 / lam, rel=1e-6)
+
+
+# ---------------------------------------------------------------------------
+# implicit equals a direct sparse solve
+
+@pytest.mark.parametrize("weights", ["cotan", "uniform"])
+def test_implicit_equals_direct_solve_closed(weights):
+    V, F = icosphere(3)
+    V = V + 0.02 * np.random.default_rng(4).standard_normal(V.shape)
+    step = 0.01 if weights == "cotan" else 3.0
+    M, C = laplacian(V, F, weights)
+    A = (M - step * C).tocsc()
+    P = V.copy()
+    for _ in range(3):
+        P = sla.spsolve(A, M @ P)
+    np.testing.assert_allclose(implicit_smoothing(V, F, step, 3, weights), P, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(implicit_smoothing(V, F, step, 3, weights, solver="cg"), P,
+                               rtol=0, atol=1e-8)
+
+
+def test_implicit_equals_direct_solve_fixed_boundary():
+    V, F = grid(12, jitter=0.6)
+    V[:, 2] = 0.05 * np.random.default_rng(5).standard_normal(len(V))
+    b = _boundary_mask(F, len(V))
+    step = 0.002
+    M, C = laplacian(V, F)
+    # the full system with identity rows at the boundary (not symmetric, solved directly)
+    A = (M - step * C).tolil()
+    rhs = M @ V
+    for i in np.flatnonzero(b):
+        A.rows[i], A.data[i] = [i], [1.0]
+    rhs[b] = V[b]
+    P = sla.spsolve(A.tocsc(), rhs)
+    np.testing.assert_allclose(implicit_smoothing(V, F, step, 1), P, rtol=0, atol=1e-10)
+
+
+def test_implicit_huge_step_stays_bounded():
+    V, F = icosphere(3)
+    V = V + 0.02 * np.random.default_rng(6).standard_normal(V.shape)
+    limit = explicit_step_limit(V, F)
+    P = implicit_smoothing(V, F, 1e4 * limit, 3)
+    assert np.isfinite(P).all()
+    assert np.abs(P).max() <= np.abs(V).max()
+
+
+def test_smoother_cache_reuses_factorisation():
+    V, F = icosphere(2)
+    S = ImplicitSmoother(V, F)
+    assert S.factor(0.1) is S.factor(0.1)
+    np.testing.assert_allclose(S.smooth(0.1, 2), implicit_smoothing(V, F, 0.1, 2), atol=1e-14)
+
+
+# ---------------------------------------------------------------------------
+# rebuilt operator (curvature flow) and divergence: stated stops, never NaN
+
+def test_rebuilt_operator_collapse_is_a_clear_error():
+    V, F = icosphere(2)
+    with pytest.raises(MeshError, match="implicit smoothing stopped") as info:
+        implicit_smoothing(V, F, 1.0, 20, rebuild=True)
+    assert np.isfinite(info.value.V).all()
+    with pytest.warns(MeshWarning, match="stopped and returned"):
+        P = implicit_smoothing(V, F, 1.0, 20, rebuild=True, on_failure="stop")
+    assert np.isfinite(P).all()
+
+
+def test_rebuilt_operator_small_step_is_curvature_flow():
+    # sphere under mean curvature flow: r(t)^2 = r0^2 - 4 t; implicit Euler lags a little
+    V, F = icosphere(3)
+    P = implicit_smoothing(V, F, 0.005, 10, rebuild=True)
+    r = np.linalg.norm(P, axis=1)
+    assert r.std() / r.mean() < 1e-3
+    assert abs(r.mean() - np.sqrt(1 - 4 * 0.05)) < 0.01
+
+
+def test_explicit_divergence_stops_cleanly():
+    V, F = icosphere(2)
+    V = V + 1e-3 * np.random.default_rng(7).standard_normal(V.shape)
+    limit = explicit_step_limit(V, F)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        with pytest.raises(MeshError, match="diverged"):
+            explicit_smoothing(V, F, 3 * limit, 500)
+    with pytest.warns(MeshWarning) as record:
+        P = explicit_smoothing(V, F, 3 * limit, 500, on_failure="stop")
+    assert np.isfinite(P).all()
+    assert any("diverged" in str(w.message) for w in record)
+
+
+# ---------------------------------------------------------------------------
+# bad input
+
+@pytest.mark.parametrize("step", [-0.1, float("nan"), float("inf"), "0.1", None, True])
+def test_bad_step(step):
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match="step"):
+        implicit_smoothing(V, F, step, 1)
+    with pytest.raises(MeshError, match="step"):
+        explicit_smoothing(V, F, step, 1) if step is not None else explicit_smoothing(V, F, None, 1)
+
+
+@pytest.mark.parametrize("iterations", [-1, 1.5, "3", True])
+def test_bad_iterations(iterations):
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match="iterations"):
+        implicit_smoothing(V, F, 0.1, iterations)
+    with pytest.raises(MeshError, match="iterations"):
+        explicit_smoothing(V, F, 0.001, iterations)
+
+
+def test_bad_options():
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match="weights"):
+        implicit_smoothing(V, F, 0.1, 1, weights="mean")
+    with pytest.raises(MeshError, match="boundary"):
+        explicit_smoothing(V, F, 0.001, 1, boundary="clamped")
+    with pytest.raises(MeshError, match="exactly one"):
+        explicit_smoothing(V, F, 0.001, 1, step_fraction=0.5)
+    with pytest.raises(MeshError, match="step_fraction"):
+        explicit_smoothing(V, F, step_fraction=-0.5)
+
+
+def test_step_past_limit_warns_once_naming_the_limit():
+    V, F = icosphere(2)
+    limit = explicit_step_limit(V, F)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        P = explicit_smoothing(V, F, 1.05 * limit, 30)
+    msgs = [str(w.message) for w in record if issubclass(w.category, MeshWarning)]
+    assert len(msgs) == 1
+    assert f"{limit:.6g}" in msgs[0]
+    assert np.isfinite(P).all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        explicit_smoothing(V, F, 0.999 * limit, 3)  # no warning below the limit
+
+
+def test_progress_bar_options_do_not_change_results(capsys):
+    V, F = icosphere(2)
+    a = implicit_smoothing(V, F, 0.01, 3, progress=True)
+    b = implicit_smoothing(V, F, 0.01, 3, progress=False)
+    np.testing.assert_array_equal(a, b)
+    c = explicit_smoothing(V, F, 1e-4, 3, progress=True)
+    np.testing.assert_array_equal(c, explicit_smoothing(V, F, 1e-4, 3, progress=None))
+
+
+# ---------------------------------------------------------------------------
+# the course meshes (skipped when the course folder is absent)
+
+@pytest.mark.skipif(not (COURSE / "smoothing" / "plane_ns.obj").exists(), reason="course meshes absent")
+def test_course_noisy_plane():
+    from geomlib import load_mesh
+
+    V, F = load_mesh(COURSE / "smoothing" / "plane_ns.obj")
+    limit = explicit_step_limit(V, F)
+    assert 0 < limit < 1e-3  # bbox diagonal 0.27: a tiny length^2 step
+    M, C = laplacian(V, F, "uniform")
+
+    def roughness(P):  # mean length of the uniform Laplacian (umbrella) vector
+        return np.linalg.norm((C @ P) / M.diagonal()[:, None], axis=1).mean()
+
+    P = implicit_smoothing(V, F, 100 * limit, 5)
+    Q = explicit_smoothing(V, F, step_fraction=0.9, iterations=50)
+    assert roughness(P) < 0.5 * roughness(V)
+    assert roughness(Q) < 0.5 * roughness(V)
