@@ -153,11 +153,15 @@ def _finite(name, value):
     return x
 
 
-def _count(name, value, minimum):
+def _count(name, value, minimum, maximum=2048):
+    """An integer resolution in [minimum, maximum]; the upper bound keeps a
+    typo (subdivisions=12: 168 million vertices) from exhausting memory."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise MeshError(f"{name} must be an integer >= {minimum}, got {value!r}")
     if value < minimum:
         raise MeshError(f"{name} must be >= {minimum}, got {value}")
+    if value > maximum:
+        raise MeshError(f"{name} = {value} is more than the limit {maximum} (too many vertices)")
     return int(value)
 
 
@@ -490,7 +494,7 @@ def icosphere(subdivisions=3):
     P : (n, 3) float64 unit vectors
     F : (m, 3) int64
     """
-    k = _count("subdivisions", subdivisions, 0)
+    k = _count("subdivisions", subdivisions, 0, 9)
     P, F = _icosahedron()
     for _ in range(k):
         E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
@@ -593,7 +597,7 @@ def sphere(r=1.0, subdivisions=3, jitter=0.0, seed=0):
         area 4 pi r^2, volume 4/3 pi r^3; closed.
     """
     r = _positive("r", r)
-    subdivisions = _count("subdivisions", subdivisions, 0)
+    subdivisions = _count("subdivisions", subdivisions, 0, 9)
     jitter = _jitter(jitter)
     P, F = icosphere(subdivisions)
     if jitter > 0:
@@ -634,7 +638,7 @@ def ellipsoid(a=1.0, b=0.7, c=0.5, subdivisions=3, jitter=0.0, seed=0):
         Closed; exact area (elliptic integrals) and volume 4/3 pi a b c.
     """
     a, b, c = _positive("a", a), _positive("b", b), _positive("c", c)
-    subdivisions = _count("subdivisions", subdivisions, 0)
+    subdivisions = _count("subdivisions", subdivisions, 0, 9)
     jitter = _jitter(jitter)
     P, F = icosphere(subdivisions)
     if jitter > 0:
