@@ -530,7 +530,7 @@ class MeshComparison:
         if hausdorff:
             out["hausdorff"] = self.hausdorff(V)
         out["normal_mean"] = float(angles.mean())
-        out["normal_p95"] = float(np.percentile(angles, 95))
+        out["normal_p95"] = _percentile(angles, 95.0)
         out["area_change"] = 0.5 * float(_norms(N).sum()) / self.area_clean - 1.0
         if self.closed:
             out["volume_change"] = (_volume(V, self.F, N) - self.volume_clean) / abs(self.volume_clean)
@@ -543,6 +543,15 @@ class MeshComparison:
         else:
             out["sharp_edge_error"] = float("nan")
         return out
+
+
+def _percentile(x, q):
+    """``np.percentile(x, q)`` (linear interpolation) from two order statistics."""
+    pos = q / 100.0 * (len(x) - 1)
+    lo = int(np.floor(pos))
+    hi = min(lo + 1, len(x) - 1)
+    part = np.partition(x, [lo, hi])
+    return float(part[lo] + (pos - lo) * (part[hi] - part[lo]))
 
 
 def _volume(V, F, N):
@@ -746,16 +755,24 @@ SWEEP_KEYS = ("rms", "normal_mean", "normal_p95", "area_change", "volume_change"
               "sharp_edge_error")
 
 
-def mean_edge_length(V, F):
-    """Mean length of the mesh's edges, each counted once (length units)."""
+def unique_edges(F):
+    """Every edge of the triangles once, as sorted vertex pairs (k, 2) int64."""
+    F = np.asarray(F, dtype=np.int64)
+    E = np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    return np.unique(E, axis=0)
+
+
+def mean_edge_length(V, F, edges=None):
+    """Mean length of the mesh's edges, each counted once (length units).
+
+    ``edges``: the result of :func:`unique_edges` for F, to avoid recomputing it."""
     V = _as_vertices(V)
     F = _as_faces(F, len(V))
-    E = np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    E = np.unique(E, axis=0)
-    return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())
+    E = unique_edges(F) if edges is None else edges
+    return float(_norms(V[E[:, 0]] - V[E[:, 1]]).mean())
 
 
-def scale_free_step(V, F, method, weights, value):
+def scale_free_step(V, F, method, weights, value, edges=None):
     """The smoothing step (units of :mod:`geomlib.smoothing`) for a scale-free ``value``.
 
     * explicit: ``value`` is a fraction of the stability limit of this mesh,
@@ -779,7 +796,7 @@ def scale_free_step(V, F, method, weights, value):
     if weights == "uniform":
         return float(value)
     if weights == "cotan":
-        return float(value) * mean_edge_length(V, F) ** 2 / 4.0
+        return float(value) * mean_edge_length(V, F, edges) ** 2 / 4.0
     raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
 
 
@@ -909,6 +926,7 @@ def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fraction
                             "'implicit', weights 'uniform' and 'cotan'")
     out = SmoothingSweep(sigmas, schemes, step_values, iterations)
     where = {int(k): l for l, k in enumerate(iterations)}
+    edges = unique_edges(C.F)
     last = int(iterations[-1])
     runs = sum(len(step_values[m]) for m, _ in schemes) * len(out.sigmas)
     bar = None
@@ -925,7 +943,7 @@ def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fraction
             for j, (method, weights) in enumerate(schemes):
                 smoother = ImplicitSmoother(Vn, C.F, weights) if method == "implicit" else None
                 for k, value in enumerate(step_values[method]):
-                    step = scale_free_step(Vn, C.F, method, weights, value)
+                    step = scale_free_step(Vn, C.F, method, weights, value, edges)
                     out.steps[i, j, k] = step
 
                     def record(it, P, i=i, j=j, k=k):
