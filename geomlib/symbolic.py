@@ -610,6 +610,22 @@ class ParametricSurface:
                 return H + R, H - R
         elif name == "principal_directions":
             def f(u, v, *rest):
+                u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+                # Where the parameterisation is singular (p_u or p_v = 0, e.g. the
+                # ellipsoid's poles) the frame p_u/|p_u| is undefined: evaluate at v
+                # moved by 1e-8 into the domain. Principal directions are continuous
+                # away from umbilics, so this is their value at the point to ~1e-8.
+                pu = np.stack(evaluate("p_u", u, v, rest)[0], axis=-1)
+                pv = np.stack(evaluate("p_v", u, v, rest)[0], axis=-1)
+                E = np.einsum("...i,...i->...", pu, pu)
+                G = np.einsum("...i,...i->...", pv, pv)
+                bad = (E <= 1e-20 * (E + G)) | (G <= 1e-20 * (E + G))
+                if np.any(bad):
+                    v = v.copy()
+                    step = 1e-8 * np.maximum(1.0, np.abs(v[bad]))
+                    up = evaluate("area_element", u[bad], v[bad] + step, rest)[0][0]
+                    down = evaluate("area_element", u[bad], v[bad] - step, rest)[0][0]
+                    v[bad] = np.where(np.abs(up) >= np.abs(down), v[bad] + step, v[bad] - step)
                 (A, B, C), _ = evaluate("frame_coefficients", u, v, rest)
                 comps, _ = evaluate("frame", u, v, rest)
                 e1 = np.stack(comps[:3], axis=-1)

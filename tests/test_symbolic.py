@@ -322,6 +322,23 @@ def test_euler_theorem_symbolic_at_a00():
     assert phi1 == 0 and list(d1) == [0, 1, 0] and list(d2) == [0, 0, -1]
 
 
+def test_ellipsoid_poles_are_finite_and_exact():
+    # p_u = 0 at v = 0, pi; curvature there is c/a^2 along x and c/b^2 along y
+    a, b, c = 1.0, 2.0, 3.0
+    E = ellipsoid(a, b, c)
+    u = np.array([0.0, 0.7, 2.0, 0.0, 1.1])
+    v = np.array([0.0, 0.0, 0.0, np.pi, np.pi])
+    k1, k2 = E.lambdify("principal_curvatures")(u, v)
+    np.testing.assert_allclose(k1, c / a**2, rtol=1e-12)
+    np.testing.assert_allclose(k2, c / b**2, rtol=1e-12)
+    np.testing.assert_allclose(E.lambdify("mean_curvature")(u, v), (c / a**2 + c / b**2) / 2, rtol=1e-12)
+    np.testing.assert_allclose(E.lambdify("gaussian_curvature")(u, v), c**2 / (a * b) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(E.lambdify("unit_normal")(u, v)[:, 2]), 1, atol=1e-12)
+    d1, d2 = E.lambdify("principal_directions")(u, v)
+    np.testing.assert_allclose(np.abs(d1), np.tile([1.0, 0, 0], (5, 1)), atol=1e-6)
+    np.testing.assert_allclose(np.abs(d2), np.tile([0, 1.0, 0], (5, 1)), atol=1e-6)
+
+
 # ------------------------------------------------- torus, saddle, helicoid
 def test_torus_equators():
     R, r = sp.symbols("R r", positive=True)
