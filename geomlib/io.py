@@ -513,7 +513,7 @@ def load_mesh(path, report=False):
         data = p.read_bytes()
     except OSError as exc:
         raise MeshError(f"{where}: cannot read the file: {exc.strerror or exc}") from None
-    if not data.strip():
+    if not data or data.isspace():  # isspace stops at the first other byte
         raise MeshError(f"{where}: the file is empty")
     if ext == ".obj":
         V, F = _read_obj(data, where)

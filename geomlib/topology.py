@@ -45,10 +45,12 @@ def _sort_with_order(key):
     k = len(key)
     if k == 0:
         return key, np.zeros(0, np.int64)
-    top = int(key.max())
-    if top < _INT64_MAX // max(k, 1) - 1:
-        packed = np.sort(key * k + np.arange(k, dtype=np.int64))
-        return packed // k, packed % k
+    bits = max(int(k - 1).bit_length(), 1)
+    if int(key.max()) < (1 << (62 - bits)):  # key and index share one non-negative int64
+        packed = np.left_shift(key, bits)
+        packed |= np.arange(k, dtype=np.int64)
+        packed.sort()
+        return packed >> bits, packed & ((1 << bits) - 1)
     order = np.argsort(key, kind="stable")
     return key[order], order
 
@@ -76,8 +78,8 @@ class _Topology:
         self.order = order
         self.group_start = starts
         self.edge_face_count = np.diff(np.append(starts, 3 * m))
-        key = sk[starts]
-        self.E = np.stack([key // n, key % n], axis=1)
+        h = order[starts]
+        self.E = np.stack([lo[h], hi[h]], axis=1)
         self.vertex_face_count = np.bincount(self.I, minlength=n)
 
     def boundary_halfedges(self):
@@ -122,8 +124,8 @@ class _Topology:
         twin[h1] = h2
         twin[h2] = h1
         c = np.arange(m3, dtype=np.int64)
-        k = c % 3
-        nxt = twin[c - k + (k + 2) % 3]
+        # the half-edge entering the corner's vertex: slot (s + 2) % 3 of the same face
+        nxt = twin[c + np.tile(np.array([2, -1, -1], np.int64), m3 // 3)]
         term = nxt < 0
         nxt[term] = c[term]
         return nxt, twin
@@ -286,6 +288,61 @@ def boundary_vertices(F, n=None):
 
 def _loops_from_edges(B):
     """Chain directed boundary edges into loops (see :func:`boundary_loops`)."""
+    if len(B) == 0:
+        return []
+    loops = _loops_vectorised(B)
+    return loops if loops is not None else _loops_walk(B)
+
+
+def _loops_vectorised(B):
+    """Loops when every boundary vertex has one edge out and one in (the usual case).
+
+    The successor map is then a permutation of the boundary vertices. Pointer
+    jumping (log2 of the longest loop steps) labels each vertex with the
+    smallest vertex of its loop and, with the loop cut just before that
+    vertex, ranks it by its distance to the loop's end. Returns None when a
+    vertex has two outgoing or incoming boundary edges.
+    """
+    a, b = B[:, 0], B[:, 1]
+    n = int(B.max()) + 1
+    if np.bincount(a, minlength=n).max() > 1 or np.bincount(b, minlength=n).max() > 1:
+        return None
+    verts = np.sort(a)
+    if not np.array_equal(verts, np.sort(b)):
+        return None
+    k = len(verts)
+    local = np.full(n, -1, np.int64)
+    local[verts] = np.arange(k)
+    nxt = np.empty(k, np.int64)
+    nxt[local[a]] = local[b]
+    # smallest vertex of each loop (local indices are sorted like the vertices)
+    lab, jump = np.arange(k), nxt.copy()
+    while True:
+        new = np.minimum(lab, lab[jump])
+        if np.array_equal(new, lab):
+            break
+        lab, jump = new, jump[jump]
+    # cut each loop before its smallest vertex and rank by distance to the cut
+    prev = np.empty(k, np.int64)
+    prev[nxt] = np.arange(k)
+    nxt = nxt.copy()
+    tail = prev[lab[lab == np.arange(k)]]  # predecessor of each loop's first vertex
+    nxt[tail] = tail
+    dist = (nxt != np.arange(k)).astype(np.int64)
+    while True:
+        dist_new = dist + dist[nxt]
+        nxt_new = nxt[nxt]
+        if np.array_equal(nxt_new, nxt):
+            break
+        dist, nxt = dist_new, nxt_new
+    order = np.lexsort((-dist, lab))
+    sizes = np.bincount(lab)
+    sizes = sizes[sizes > 0]
+    return [verts[part] for part in np.split(order, np.cumsum(sizes)[:-1])]
+
+
+def _loops_walk(B):
+    """Chain directed boundary edges one by one (any input, also non-manifold)."""
     out = {}
     for a, b in B.tolist():
         out.setdefault(a, []).append(b)

@@ -283,3 +283,21 @@ def test_camel_pinch_vertex_one_ring():
     with pytest.raises(MeshError, match="vertex 946 is non-manifold"):
         one_ring(F, 946)
     assert len(one_ring(F, 0)) == valence(F)[0]
+
+
+def test_loop_chaining_vectorised_matches_walk():
+    from geomlib.topology import _loops_vectorised, _loops_walk
+
+    V, F = grid(7)
+    holed = F[~np.isin(F, [16, 17, 23, 24]).any(axis=1)]
+    separate = np.arange(3 * 50).reshape(-1, 3)[np.random.default_rng(2).permutation(50)]
+    for faces in (F, holed, separate, disk(11)[1]):
+        B = boundary_edges(faces)
+        fast, slow = _loops_vectorised(B), _loops_walk(B)
+        assert fast is not None and len(fast) == len(slow)
+        assert all(np.array_equal(a, b) for a, b in zip(fast, slow))
+    # a bow tie: vertex 0 has two outgoing boundary edges, so the walk decides
+    bow = np.array([[0, 1, 2], [0, 3, 4]])
+    assert _loops_vectorised(boundary_edges(bow)) is None
+    loops = boundary_loops(bow)
+    assert sorted(len(l) for l in loops) == [3, 3]
