@@ -16,7 +16,8 @@ colour bar.
 
 Controls in the browser: left drag orbits, the wheel (or middle drag) zooms,
 right drag (or ctrl + left drag) pans. The camera starts framed on the mesh's
-bounding box, looking at its centre.
+bounding box, looking at its centre, with z up (``up="y"`` for models stored
+y-up).
 
 Marking views and sliders (the browser tests rely on it)
 --------------------------------------------------------
@@ -70,8 +71,14 @@ __all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fa
 NAN_COLOR = (0.62, 0.62, 0.62)
 #: colour of a surface without values
 PLAIN_COLOR = (0.74, 0.78, 0.86)
-#: default viewing direction (from the bounding-box centre towards the eye); y is up
-VIEW_DIRECTION = (0.55, 0.45, 1.0)
+#: the axis drawn upwards -> (up vector, viewing direction from the bounding-box
+#: centre towards the eye): from the front, a little from the right and above
+VIEWS = {
+    "z": ((0.0, 0.0, 1.0), (0.55, -1.0, 0.5)),
+    "y": ((0.0, 1.0, 0.0), (0.55, 0.5, 1.0)),
+    "x": ((1.0, 0.0, 0.0), (0.5, 0.55, 1.0)),
+}
+UP, VIEW_DIRECTION = VIEWS["z"]
 #: vertical field of view of the camera in degrees
 FOV = 30.0
 
@@ -230,6 +237,29 @@ def _corner_matrix(F, n):
     return sp.csr_matrix((np.ones(3 * m, dtype=np.float64), (rows, cols)), shape=(n, m))
 
 
+def _face_normal_sums(P, Fc, S):
+    """S @ (face cross products), coordinate by coordinate (gathers of 1-D arrays are fast)."""
+    x, y, z = (np.ascontiguousarray(P[:, c]) for c in range(3))
+    i, j, k = Fc
+    ax, ay, az = x[j] - x[i], y[j] - y[i], z[j] - z[i]
+    bx, by, bz = x[k] - x[i], y[k] - y[i], z[k] - z[i]
+    Nf = np.empty((len(i), 3), dtype=P.dtype)
+    Nf[:, 0] = ay * bz - az * by
+    Nf[:, 1] = az * bx - ax * bz
+    Nf[:, 2] = ax * by - ay * bx
+    return S @ Nf
+
+
+def _normalise(N):
+    length = np.sqrt(np.einsum("ij,ij->i", N, N))
+    zero = length == 0
+    length[zero] = 1.0
+    N /= length[:, None]
+    if zero.any():
+        N[zero] = (0.0, 0.0, 1.0)
+    return N
+
+
 def vertex_normals_fast(V, F, S=None):
     """Unit vertex normals: the area-weighted sum of the incident face normals.
 
@@ -243,18 +273,11 @@ def vertex_normals_fast(V, F, S=None):
     (n, 3) float64
     """
     V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F)
     if S is None:
         S = _corner_matrix(F, V.shape[0])
-    p0 = V[F[:, 0]]
-    Nf = np.cross(V[F[:, 1]] - p0, V[F[:, 2]] - p0)
-    N = S @ Nf
-    length = np.sqrt(np.einsum("ij,ij->i", N, N))
-    zero = length == 0
-    length[zero] = 1.0
-    N /= length[:, None]
-    if zero.any():
-        N[zero] = (0.0, 0.0, 1.0)
-    return N
+    Fc = [np.ascontiguousarray(F[:, c]) for c in range(3)]
+    return _normalise(_face_normal_sums(V, Fc, S))
 
 
 # ----------------------------------------------------------------------------
@@ -275,19 +298,19 @@ def _camera_distance(radius, width, height, fov=FOV):
     return 0.95 * radius / np.sin(min(half_v, half_h))
 
 
-def _basis(direction, up=(0.0, 1.0, 0.0)):
+def _basis(direction, up=UP):
     w = np.asarray(direction, dtype=np.float64)
     w = w / np.linalg.norm(w)
     right = np.cross(up, w)
     if np.linalg.norm(right) < 1e-9:
-        right = np.cross((0.0, 0.0, 1.0), w)
+        right = np.cross(np.roll(up, 1), w)
     right /= np.linalg.norm(right)
     return right, np.cross(w, right), w
 
 
-def _look_at_quaternion(direction):
-    """Quaternion (x, y, z, w) of a camera at ``direction`` looking at the origin, y up."""
-    right, up, w = _basis(direction)
+def _look_at_quaternion(direction, up=UP):
+    """Quaternion (x, y, z, w) of a camera at ``direction`` looking at the origin, ``up`` up."""
+    right, up, w = _basis(direction, up)
     R = np.column_stack([right, up, w])  # camera looks along -w
     tr = np.trace(R)
     if tr > 0:
@@ -305,7 +328,7 @@ def _look_at_quaternion(direction):
 
 
 def render_still(V, F, colors, normals=None, width=420, height=340, direction=VIEW_DIRECTION,
-                 distance=None, fov=FOV, background=(1.0, 1.0, 1.0)):
+                 up=UP, distance=None, fov=FOV, background=(1.0, 1.0, 1.0)):
     """Draw the mesh as the viewer's camera first sees it, into an RGB image.
 
     A z-buffer rasteriser in numpy: vertices are projected with the camera of
@@ -322,7 +345,7 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
     centre, radius = _frame(V)
     if distance is None:
         distance = _camera_distance(radius, width, height, fov)
-    right, up, w = _basis(direction)
+    right, up, w = _basis(direction, up)
     P = V - centre
     eye = w * distance
     depth = distance - P @ w                      # distance along the viewing axis
@@ -494,6 +517,11 @@ class MeshView:
         Heading shown above the canvas.
     label : str or None
         Name and unit of the values, shown under the colour bar, e.g. "H (1/length)".
+    up : {"z", "y", "x"}
+        The axis drawn upwards. "z" suits the workbook's meshes and height
+        fields such as the course's plane; scanned models (bunny, armadillo)
+        usually want "y". The camera looks from the front, a little from the
+        right and above; orbit from there.
 
     Attributes
     ----------
@@ -509,14 +537,16 @@ class MeshView:
     """
 
     def __init__(self, V, F, values=None, cmap=None, symmetric=False, vmin=None, vmax=None,
-                 wireframe=False, width=420, height=340, title=None, label=None):
+                 wireframe=False, width=420, height=340, title=None, label=None, up="z"):
         import ipywidgets as widgets
         import pythreejs as three
 
         V = _check_vertices(V)
         self._n = V.shape[0]
         self._F = _check_faces(F, self._n)
-        self._S = _corner_matrix(self._F, self._n)
+        # prepared once: corner columns and the float32 corner matrix for the normals
+        self._Fc = [np.ascontiguousarray(self._F[:, c]) for c in range(3)]
+        self._S32 = _corner_matrix(self._F, self._n).astype(np.float32)
         self._V = V
         self._values = None if values is None else _check_values(values, self._n)
         self.symmetric = bool(symmetric)
@@ -525,6 +555,10 @@ class MeshView:
         self._fixed = (vmin, vmax)
         self.width, self.height = int(width), int(height)
         self.title, self.label = title, label
+        if up not in VIEWS:
+            raise MeshError(f"up must be one of 'x', 'y', 'z' (the axis drawn upwards); got {up!r}")
+        self.up = up
+        self._up, self._direction = VIEWS[up]
         self._centre, self._radius = _frame(V)
         self._distance = _camera_distance(self._radius, self.width, self.height)
 
@@ -540,8 +574,7 @@ class MeshView:
             vertexShader=_VERTEX_SHADER, fragmentShader=_FRAGMENT_SHADER,
             vertexColors="VertexColors", side="DoubleSide", lights=False, fog=False,
             polygonOffset=True, polygonOffsetFactor=1.0, polygonOffsetUnits=1.0)
-        offset = tuple(float(-c) for c in self._centre)   # the mesh is centred at the origin
-        self.mesh = three.Mesh(geometry=self.geometry, material=material, position=offset)
+        self.mesh = three.Mesh(geometry=self.geometry, material=material)
         children = [self.mesh]
         if wireframe:
             E = np.sort(self._F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
@@ -551,8 +584,7 @@ class MeshView:
                 attributes={"position": position})
             self.wireframe = three.LineSegments(
                 geometry=lines,
-                material=three.LineBasicMaterial(color="#1a1a1a", transparent=True, opacity=0.45),
-                position=offset)
+                material=three.LineBasicMaterial(color="#1a1a1a", transparent=True, opacity=0.45))
             children.append(self.wireframe)
         else:
             self.wireframe = None
@@ -560,8 +592,8 @@ class MeshView:
         self.camera = three.PerspectiveCamera(
             fov=FOV, aspect=self.width / self.height,
             near=self._distance * 0.01, far=self._distance * 100.0,
-            position=tuple(float(x) for x in _basis(VIEW_DIRECTION)[2] * self._distance),
-            quaternion=_look_at_quaternion(VIEW_DIRECTION), up=(0.0, 1.0, 0.0))
+            position=tuple(float(x) for x in _basis(self._direction, self._up)[2] * self._distance),
+            quaternion=_look_at_quaternion(self._direction, self._up), up=self._up)
         self.controls = three.OrbitControls(controlling=self.camera, target=(0.0, 0.0, 0.0))
         self.renderer = three.Renderer(camera=self.camera, scene=self.scene, controls=[self.controls],
                                        width=self.width, height=self.height, antialias=True)
@@ -599,6 +631,11 @@ class MeshView:
         return value_range(self._values, self.symmetric, *self._fixed)
 
     @property
+    def positions(self):
+        """(n, 3) float32 positions as sent to the browser (relative to the first bounding-box centre)."""
+        return self._buffer.array[:, 0:3].copy()
+
+    @property
     def colors(self):
         """(n, 3) float32 vertex colours in [0, 1] as sent to the browser."""
         return self._buffer.array[:, 6:9].copy()
@@ -617,8 +654,11 @@ class MeshView:
     def _pack(self, V=True, colors=True, old=None):
         buf = np.empty((self._n, 9), dtype=np.float32)
         if V:
-            buf[:, 0:3] = self._V
-            buf[:, 3:6] = vertex_normals_fast(self._V, self._F, self._S)
+            # positions relative to the first bounding-box centre (float32 keeps
+            # its precision near the origin); normals in float32 from those
+            P = (self._V - self._centre).astype(np.float32)
+            buf[:, 0:3] = P
+            buf[:, 3:6] = _normalise(_face_normal_sums(P, self._Fc, self._S32))
         else:
             buf[:, 0:6] = old[:, 0:6]
         if colors:
@@ -678,7 +718,8 @@ class MeshView:
         """(h, w, 3) uint8 still picture: the first camera view, title and colour bar."""
         buf = self._buffer.array
         image = render_still(self._V, self._F, buf[:, 6:9], buf[:, 3:6].astype(np.float64),
-                             self.width, self.height, distance=distance or self._distance)
+                             self.width, self.height, direction=self._direction, up=self._up,
+                             distance=distance or self._distance)
         lo, hi = self.range
         lut = self._lut if self._values is not None else None
         return _still_with_colorbar(image, lut, lo, hi, self.label or "", self.title)
@@ -760,11 +801,12 @@ def side_by_side(*views, link_cameras=True):
         radius = max(v._radius for v in views)
         distance = _camera_distance(radius, first.width, first.height)
         cam = first.camera
-        cam.position = tuple(float(x) for x in _basis(VIEW_DIRECTION)[2] * distance)
+        cam.position = tuple(float(x) for x in _basis(first._direction, first._up)[2] * distance)
         cam.near, cam.far = distance * 0.01, distance * 100.0
         for v in views:
             v._distance = distance
         for v in views[1:]:
+            v._up, v._direction, v.up = first._up, first._direction, first.up
             v.width, v.height = first.width, first.height
             v.renderer.width, v.renderer.height = first.width, first.height
             v._colorbar.value = v._colorbar_text()

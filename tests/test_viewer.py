@@ -124,7 +124,8 @@ def test_update_overwrites_buffers_in_place_with_one_message(sphere, messages):
     for name, attribute in view.geometry.attributes.items():
         assert attribute is attributes[name]
         assert attribute.data is buffer
-    np.testing.assert_allclose(buffer.array[:, 0:3], W, rtol=1e-6)
+    np.testing.assert_allclose(buffer.array[:, 0:3] + view._centre, W, atol=1e-6)
+    np.testing.assert_allclose(view.V, W)
     np.testing.assert_allclose(view.colors, colorize(W[:, 1], "viridis", -2.0, 2.0), atol=1e-6)
     assert not np.allclose(view.colors, colors_before)
     assert buffer.array.dtype == np.float32 and buffer.array.shape == (len(V), 9)
@@ -200,9 +201,9 @@ def test_mimebundle_has_widget_png_and_text(sphere):
 
 def test_still_puts_the_mesh_in_the_middle():
     # a unit square facing the camera direction fills the middle, corners stay background
-    from geomlib.viewer import VIEW_DIRECTION, _basis
+    from geomlib.viewer import UP, VIEW_DIRECTION, _basis
 
-    right, up, w = _basis(VIEW_DIRECTION)
+    right, up, w = _basis(VIEW_DIRECTION, UP)
     corners = np.array([-right - up, right - up, right + up, -right + up])
     F = np.array([[0, 1, 2], [0, 2, 3]])
     colors = np.tile([1.0, 0.0, 0.0], (4, 1))
