@@ -77,6 +77,7 @@ _EXPORTS = {
     "denoising_metrics": "metrics",
     "MeshComparison": "metrics",
     "point_surface_distance": "metrics",
+    "smoothing_sweep": "metrics",
 }
 
 __all__ = sorted(["MeshError", "MeshWarning", "data_path", *_EXPORTS])

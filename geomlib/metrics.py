@@ -13,6 +13,9 @@ The functions take the arrays and recompute what they need. For many
 comparisons against the same clean mesh (a parameter sweep) build one
 :class:`MeshComparison`: it computes the clean mesh's normals, edges,
 dihedral angles, area, volume and surface samples once.
+:func:`smoothing_sweep` runs explicit and implicit smoothing (uniform and
+cotangent weights) over noise levels, scale-free steps and iteration counts
+and records every metric (notebook 07).
 
 Degenerate and special cases are stated where they are handled:
 
