@@ -6,8 +6,10 @@ counter-clockwise seen from outside. Face ``f`` traverses the directed edges
 exactly one face and is reported in the direction that face traverses it, so
 walking along it the face lies on the left seen from outside.
 
-Everything is vectorised (one sort of the 3m half-edges) except the walks
-along boundary loops and around one vertex, which are short.
+Everything is vectorised around one sort of the 3m half-edges; loops are
+followed by pointer jumping (log2 of the longest loop steps). The only Python
+loops are the walk around a single vertex in :func:`one_ring` and the chaining
+of boundary loops that touch at a vertex (non-manifold boundaries), both short.
 Every function validates ``F`` at the door (:func:`geomlib.validate.as_faces`).
 """
 
