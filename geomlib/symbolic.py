@@ -38,6 +38,11 @@ where ``w`` is the unit tangent perpendicular to ``p_u`` obtained by turning
 seen from outside ``phi`` turns clockwise.) The normal curvature is
 ``kappa_n(phi) = II(t, t)`` (``I(t, t) = 1``).
 
+At singular points of a parameterisation (the ellipsoid's poles, where
+``p_u = 0``) H, K, the principal curvatures and the normal are still finite
+and exact (the vanishing factor is cancelled symbolically); the frame and the
+principal directions are taken 1e-8 inside the domain there.
+
 Every symbolic result is simplified once and cached per surface. Surfaces with
 numeric parameters (``ellipsoid(1, 2, 3)``) are computed once per family with
 positive parameter symbols and then substituted, and ``lambdify(name)`` compiles
@@ -239,6 +244,10 @@ class ParametricSurface:
             sub.update({s: float(rng.uniform(0.6, 1.9)) for s in free})
             sub[self.u] = float(rng.uniform(0.1, 1.4))
             sub[self.v] = float(rng.uniform(0.1, 1.4))
+            af = complex(self._area_factor.evalf(subs=sub)).real
+            if af < 0:
+                raise ValueError(f"area_factor = {self._area_factor} is negative at {sub}; it must be >= 0 "
+                                 "on the domain (put the sign into orientation)")
             lhs = np.array([complex(x.evalf(subs=sub)) for x in cross])
             rhs = np.array([complex((self._area_factor * d).evalf(subs=sub)) for d in self._D]) * self.orientation
             if not np.allclose(lhs, rhs, atol=1e-9 * (1 + np.abs(lhs).max())):
