@@ -34,6 +34,8 @@ Windows), always in a ``spectral`` sub-folder. ``cache=False`` neither reads
 nor writes it; :func:`clear_spectral_cache` empties it.
 """
 
+import contextlib
+import ctypes
 import hashlib
 import os
 import sys
@@ -62,7 +64,7 @@ __all__ = [
 CACHE_DIR = None
 
 #: Meshes with at most this many vertices are solved with dense LAPACK.
-DENSE_MAX_VERTICES = 1200
+DENSE_MAX_VERTICES = 600
 
 #: Bases kept in memory (each is n * k float64: 25k vertices, k = 300 is 60 MB).
 MEMORY_CACHE_SIZE = 3
@@ -71,6 +73,14 @@ MEMORY_CACHE_SIZE = 3
 _CACHE_FORMAT = 1
 
 _MEMORY = OrderedDict()
+
+#: BLAS threads used while solving (None: leave the BLAS library's own setting).
+#: One thread, because on the workbook's 2-core machines a 2-thread OpenBLAS
+#: pool that competes with other busy processes made dense ``eigh`` at 642
+#: vertices 20x slower (2.1 s instead of 0.1 s) and ARPACK's own vector work
+#: several times slower; the sparse factorisation and its solves use one
+#: thread anyway.
+BLAS_THREADS = 1
 
 
 # --------------------------------------------------------------------------
@@ -227,6 +237,56 @@ def _disk_store(folder, key, lam, E):
 
 
 # --------------------------------------------------------------------------
+# BLAS threads
+
+
+def _openblas_handles():
+    """(set, get) function pairs of every OpenBLAS loaded in this process (Linux only; else [])."""
+    handles = []
+    try:
+        with open("/proc/self/maps") as maps:
+            paths = {line.split()[-1] for line in maps if "openblas" in line.rsplit("/", 1)[-1].lower()}
+    except OSError:
+        return handles
+    for path in sorted(paths):
+        try:
+            lib = ctypes.CDLL(path)
+        except OSError:
+            continue
+        for prefix, suffix in (("openblas", ""), ("scipy_openblas", ""), ("scipy_openblas", "64_")):
+            setter = getattr(lib, f"{prefix}_set_num_threads{suffix}", None)
+            getter = getattr(lib, f"{prefix}_get_num_threads{suffix}", None)
+            if setter is not None and getter is not None:
+                getter.restype = ctypes.c_int
+                handles.append((setter, getter))
+                break
+    return handles
+
+
+@contextlib.contextmanager
+def _blas_threads(count):
+    """Run the block with ``count`` OpenBLAS threads and restore the previous setting."""
+    if not count:
+        yield
+        return
+    saved = []
+    try:
+        for setter, getter in _openblas_handles():
+            saved.append((setter, int(getter())))
+            setter(int(count))
+    except Exception:  # an unexpected BLAS build: leave it alone
+        pass
+    try:
+        yield
+    finally:
+        for setter, old in saved:
+            try:
+                setter(old)
+            except Exception:
+                pass
+
+
+# --------------------------------------------------------------------------
 # solvers
 
 
@@ -234,7 +294,10 @@ def _dense(m, C, k):
     d = 1.0 / np.sqrt(m)
     S = -(C.toarray() * d[:, None] * d[None, :])
     S = 0.5 * (S + S.T)
-    lam, Y = la.eigh(S, subset_by_index=[0, k - 1], driver="evr" if k < len(m) else "evd")
+    if k < len(m):
+        lam, Y = la.eigh(S, subset_by_index=[0, k - 1], driver="evr")
+    else:
+        lam, Y = la.eigh(S, driver="evd")
     return lam, Y
 
 
@@ -403,11 +466,12 @@ def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
             return basis
     t0 = time.perf_counter()
     dense = method == "dense" or (method == "auto" and (n <= DENSE_MAX_VERTICES or 3 * k > n))
-    if dense:
-        lam, Y = _dense(m, C, k)
-    else:
-        lam, Y = _sparse(m, C, k, tol)
-    lam, E = _finish(m, lam, Y, labels, count)
+    with _blas_threads(BLAS_THREADS):
+        if dense:
+            lam, Y = _dense(m, C, k)
+        else:
+            lam, Y = _sparse(m, C, k, tol)
+        lam, E = _finish(m, lam, Y, labels, count)
     basis = SpectralBasis(lam, E, m, count, time.perf_counter() - t0, "solved")
     if cache:
         _disk_store(folder, key, lam, E)

@@ -1,0 +1,401 @@
+"""Tests for geomlib.spectral: C e = -lam M e, E^T M E = I, reconstruction, cache."""
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import geomlib
+import geomlib.spectral as spectral
+from geomlib import (
+    MeshError,
+    MeshWarning,
+    clear_spectral_cache,
+    eigenbasis,
+    laplacian,
+    spectral_basis,
+    spectral_cache_dir,
+    spectral_reconstruction,
+)
+from geomlib.surfaces import ellipsoid, icosphere, sphere
+
+COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+
+
+@pytest.fixture(autouse=True)
+def private_cache(tmp_path, monkeypatch):
+    """Every test gets an empty cache folder of its own and an empty memory cache."""
+    monkeypatch.setenv("GEOMLIB_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(spectral, "CACHE_DIR", None)
+    spectral._MEMORY.clear()
+    yield
+    spectral._MEMORY.clear()
+
+
+@pytest.fixture(scope="module")
+def egg():
+    """An irregular ellipsoid (no repeated eigenvalues), 642 vertices."""
+    S = ellipsoid(1.0, 0.7, 0.5, subdivisions=3, jitter=0.2, seed=1)
+    return S.V, S.F
+
+
+@pytest.fixture(scope="module")
+def egg_fine():
+    """The same shape with 2562 vertices (sparse solver by default)."""
+    S = ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.2, seed=1)
+    return S.V, S.F
+
+
+def _mass(V, F, weights="cotan"):
+    M, C = laplacian(V, F, weights=weights)
+    return M.diagonal(), C
+
+
+def _rel_error(V, Vk, m):
+    return np.sqrt(np.sum(m[:, None] * (V - Vk) ** 2) / np.sum(m[:, None] * (V - V.mean(0)) ** 2))
+
+
+# --------------------------------------------------------------------------
+# identities
+
+
+@pytest.mark.parametrize("method", ["dense", "sparse"])
+def test_m_orthonormal_and_residual(egg, method):
+    V, F = egg
+    lam, E = eigenbasis(V, F, 40, method=method, cache=False)
+    m, C = _mass(V, F)
+    assert E.shape == (len(V), 40) and lam.shape == (40,)
+    assert np.abs(E.T @ (m[:, None] * E) - np.eye(40)).max() < 1e-8
+    # C E + M E diag(lam) = 0, relative to the size of C E
+    R = C @ E + (m[:, None] * E) * lam[None, :]
+    assert np.abs(R).max() < 1e-9 * np.abs(C).max()
+    assert np.all(np.diff(lam) >= 0) and lam[0] == 0.0 and lam[1] > 0
+    # the eigenvectors are M-orthonormal, NOT orthonormal
+    assert np.abs(E.T @ E - np.eye(40)).max() > 1e-2
+
+
+def test_first_eigenvector_is_the_constant(egg):
+    V, F = egg
+    lam, E = eigenbasis(V, F, 5, cache=False)
+    m, _ = _mass(V, F)
+    assert lam[0] == 0.0
+    np.testing.assert_allclose(E[:, 0], 1.0 / np.sqrt(m.sum()), rtol=1e-12)
+
+
+def test_dense_and_sparse_agree(egg):
+    V, F = egg
+    ld, Ed = eigenbasis(V, F, 30, method="dense", cache=False)
+    ls, Es = eigenbasis(V, F, 30, method="sparse", cache=False)
+    np.testing.assert_allclose(ls, ld, rtol=1e-9, atol=1e-9)
+    # simple eigenvalues here, and the sign convention fixes each vector
+    m, _ = _mass(V, F)
+    G = Ed.T @ (m[:, None] * Es)
+    np.testing.assert_allclose(np.diag(G), 1.0, atol=1e-7)
+
+
+def test_unit_sphere_eigenvalues_are_l_l_plus_1():
+    """Spherical harmonics: lam = l (l + 1), multiplicity 2 l + 1, the first 25 within 1%."""
+    S = sphere(1.0, subdivisions=4)  # 2562 vertices
+    lam, E = eigenbasis(S.V, S.F, 25, cache=False)
+    l = np.repeat(np.arange(5), 2 * np.arange(5) + 1)
+    exact = l * (l + 1.0)
+    assert lam[0] == 0.0
+    rel = np.abs(lam[1:] / exact[1:] - 1.0)
+    assert rel.max() < 0.01
+    # multiplicities: group the eigenvalues by their nearest l(l + 1)
+    nearest = np.rint((-1 + np.sqrt(1 + 4 * lam)) / 2).astype(int)
+    assert np.bincount(nearest).tolist() == [1, 3, 5, 7, 9]
+    # refining the mesh brings them closer (second order in the edge length)
+    C3 = sphere(1.0, subdivisions=3)
+    coarse, _ = eigenbasis(C3.V, C3.F, 25, cache=False)
+    assert np.abs(coarse[1:] / exact[1:] - 1.0).max() > 2.5 * rel.max()
+
+
+def test_the_l1_eigenvectors_are_the_coordinates():
+    S = sphere(1.0, subdivisions=3)
+    lam, E = eigenbasis(S.V, S.F, 4, cache=False)
+    m, _ = _mass(S.V, S.F)
+    # x, y, z lie in the span of e_1, e_2, e_3 (to discretisation error)
+    P = E[:, 1:4] @ (E[:, 1:4].T @ (m[:, None] * S.V))
+    assert np.abs(P - S.V).max() < 2e-3
+
+
+# --------------------------------------------------------------------------
+# laws
+
+
+def test_scaling_and_rigid_motion(egg):
+    V, F = egg
+    lam, E = eigenbasis(V, F, 12, cache=False)
+    s = 2.5
+    lam_s, E_s = eigenbasis(s * V, F, 12, cache=False)
+    np.testing.assert_allclose(lam_s, lam / s**2, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(E_s, E / s, rtol=1e-7, atol=1e-9)
+    rng = np.random.default_rng(3)
+    Q, _ = np.linalg.qr(rng.standard_normal((3, 3)))
+    lam_r, _ = eigenbasis(V @ Q.T + [1.0, -2.0, 0.5], F, 12, cache=False)
+    np.testing.assert_allclose(lam_r, lam, rtol=1e-9, atol=1e-12)
+
+
+def test_uniform_weights_use_the_valence(egg):
+    V, F = egg
+    lam, E = eigenbasis(V, F, 8, weights="uniform", cache=False)
+    M, C = laplacian(V, F, weights="uniform")
+    m = M.diagonal()
+    assert np.abs(E.T @ (m[:, None] * E) - np.eye(8)).max() < 1e-8
+    assert np.abs(C @ E + (m[:, None] * E) * lam).max() < 1e-9 * np.abs(C).max()
+    # the graph Laplacian ignores the geometry: same for any vertex positions
+    lam2, _ = eigenbasis(V * [3.0, 1.0, 0.2], F, 8, weights="uniform", cache=False)
+    np.testing.assert_allclose(lam2, lam, atol=1e-10)
+
+
+# --------------------------------------------------------------------------
+# reconstruction
+
+
+def test_reconstruction_error_decreases_with_k(egg_fine):
+    V, F = egg_fine
+    m, _ = _mass(V, F)
+    errors = [_rel_error(V, spectral_reconstruction(V, F, k), m) for k in (1, 2, 4, 10, 25, 60, 120)]
+    assert errors[0] == pytest.approx(1.0)  # k = 1 keeps only the (area-weighted) centroid
+    assert np.all(np.diff(errors) < 0)
+    assert errors[-1] < 0.01
+
+
+def test_reconstruction_with_one_vector_is_the_area_centroid(egg):
+    V, F = egg
+    m, _ = _mass(V, F)
+    V1 = spectral_reconstruction(V, F, 1, cache=False)
+    np.testing.assert_allclose(V1, np.broadcast_to(m @ V / m.sum(), V.shape), atol=1e-12)
+
+
+def test_k_equal_n_reproduces_the_mesh():
+    P, F = icosphere(1)  # 42 vertices
+    V = P * [1.0, 0.8, 0.6]
+    lam, E = eigenbasis(V, F, len(V), cache=False)
+    m, _ = _mass(V, F)
+    assert np.abs(E.T @ (m[:, None] * E) - np.eye(len(V))).max() < 1e-10
+    np.testing.assert_allclose(spectral_reconstruction(V, F, len(V), cache=False), V, atol=1e-12)
+    assert _rel_error(V, spectral_reconstruction(V, F, len(V) - 5, cache=False), m) > 1e-6
+
+
+def test_projection_is_m_orthogonal_not_euclidean(egg):
+    """The M projection minimises the M-norm error; the plain dot product does not."""
+    V, F = egg
+    m, _ = _mass(V, F)
+    basis = spectral_basis(V, F, 15, cache=False)
+    right = basis.reconstruct(V)
+    wrong = basis.E @ (basis.E.T @ V)
+    assert _rel_error(V, right, m) < _rel_error(V, wrong, m)
+    # the residual of the M projection is M-orthogonal to the basis
+    assert np.abs(basis.E.T @ (m[:, None] * (V - right))).max() < 1e-10
+
+
+def test_residual_norms_follow_parseval(egg):
+    V, F = egg
+    m, _ = _mass(V, F)
+    basis = spectral_basis(V, F, 30, cache=False)
+    norms = basis.residual_norms(V)
+    for k in (1, 7, 30):
+        direct = np.sqrt(np.sum(m[:, None] * (V - basis.reconstruct(V, k)) ** 2))
+        assert norms[k - 1] == pytest.approx(direct, rel=1e-7, abs=1e-10)
+
+
+# --------------------------------------------------------------------------
+# components and boundaries
+
+
+def test_several_components_give_several_zero_eigenvalues():
+    P, F = icosphere(2)
+    V = np.vstack([P, 0.5 * P + [3.0, 0.0, 0.0], 0.3 * P - [3.0, 0.0, 0.0]])
+    FF = np.vstack([F, F + len(P), F + 2 * len(P)])
+    with pytest.warns(MeshWarning, match="3 connected components"):
+        lam, E = eigenbasis(V, FF, 16, cache=False)
+    m, C = _mass(V, FF)
+    assert lam[:3].tolist() == [0.0, 0.0, 0.0] and lam[3] > 1.0
+    # indicator functions, the largest component first
+    n = len(P)
+    assert np.allclose(E[:n, 0], 1 / np.sqrt(m[:n].sum())) and np.allclose(E[n:, 0], 0)
+    assert np.allclose(E[n:2 * n, 1], 1 / np.sqrt(m[n:2 * n].sum())) and np.allclose(E[:n, 1], 0)
+    assert np.abs(E.T @ (m[:, None] * E) - np.eye(16)).max() < 1e-8
+    assert np.abs(C @ E + (m[:, None] * E) * lam).max() < 1e-9 * np.abs(C).max()
+    # each component's own spectrum: the unit sphere has 2 three times, the
+    # sphere of radius 0.5 has 2 / 0.25 = 8 three times
+    assert np.sum(np.abs(lam / 2.0 - 1.0) < 0.01) == 3
+    assert np.sum(np.abs(lam / 8.0 - 1.0) < 0.01) == 3
+
+
+def _square(n, L):
+    """Flat n x n grid of squares on [0, L]^2, each split into two triangles (open, a boundary)."""
+    x = np.linspace(0.0, L, n + 1)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    V = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    a = (i * (n + 1) + j).ravel()
+    b, c, d = a + n + 1, a + n + 2, a + 1
+    F = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])]).astype(np.int64)
+    return V, F
+
+
+def test_open_mesh_with_boundary():
+    """Natural (Neumann) boundary: the flat square's eigenvalues pi^2 (a^2 + b^2) / L^2."""
+    L = 2.0
+    V, F = _square(40, L)
+    lam, E = eigenbasis(V, F, 10, cache=False)
+    m, C = _mass(V, F)
+    assert lam[0] == 0.0 and lam[1] > 0.0
+    np.testing.assert_allclose(E[:, 0], 1 / np.sqrt(m.sum()), rtol=1e-12)
+    assert np.abs(E.T @ (m[:, None] * E) - np.eye(10)).max() < 1e-8
+    assert np.abs(C @ E + (m[:, None] * E) * lam).max() < 1e-9 * np.abs(C).max()
+    ab = sorted(a * a + b * b for a in range(5) for b in range(5))[:10]
+    np.testing.assert_allclose(lam[1:], np.pi**2 * np.array(ab[1:]) / L**2, rtol=0.01)
+
+
+# --------------------------------------------------------------------------
+# bad input
+
+
+@pytest.mark.parametrize("k", [0, -3])
+def test_k_below_one(egg, k):
+    with pytest.raises(MeshError, match="at least 1"):
+        eigenbasis(*egg, k)
+
+
+def test_k_above_vertex_count(egg):
+    V, F = egg
+    with pytest.raises(MeshError, match=f"only {len(V)} vertices"):
+        eigenbasis(V, F, len(V) + 1)
+    with pytest.raises(MeshError, match=f"only {len(V)} vertices"):
+        spectral_reconstruction(V, F, len(V) + 1)
+
+
+@pytest.mark.parametrize("k", [2.5, "10", True, None])
+def test_k_not_an_integer(egg, k):
+    with pytest.raises(MeshError, match="integer"):
+        eigenbasis(*egg, k)
+
+
+def test_isolated_vertex_is_named(egg):
+    V, F = egg
+    V2 = np.vstack([V, [[5.0, 5.0, 5.0]]])
+    with pytest.raises(MeshError, match=f"vertices {len(V)}"):
+        eigenbasis(V2, F, 5, cache=False)
+
+
+def test_bad_method(egg):
+    with pytest.raises(MeshError, match="method"):
+        eigenbasis(*egg, 5, method="lobster")
+
+
+def test_k_beyond_basis_in_reconstruct(egg):
+    basis = spectral_basis(*egg, 5, cache=False)
+    with pytest.raises(MeshError, match="1..5"):
+        basis.reconstruct(egg[0], 6)
+
+
+# --------------------------------------------------------------------------
+# the cache
+
+
+def test_cache_round_trip_and_slices(egg_fine, tmp_path):
+    V, F = egg_fine
+    b = spectral_basis(V, F, 30)
+    assert b.source == "solved"
+    files = list(spectral_cache_dir().glob("*.npz"))
+    assert len(files) == 1 and files[0].name.endswith("-k30.npz")
+    # memory: same numbers, no solve
+    b2 = spectral_basis(V, F, 30)
+    assert b2.source == "solved" and b2 is b
+    # disk, as after a kernel restart; a basis with more pairs serves fewer
+    spectral._MEMORY.clear()
+    b3 = spectral_basis(V, F, 12)
+    assert b3.source == "disk"
+    np.testing.assert_array_equal(b3.E, b.E[:, :12])
+    lam, E = eigenbasis(V, F, 12)
+    np.testing.assert_array_equal(lam, b.lam[:12])
+
+
+def test_cache_invalidated_by_mesh_and_operator(egg):
+    V, F = egg
+    spectral_basis(V, F, 10)
+    spectral._MEMORY.clear()
+    assert spectral_basis(V, F, 10, area="mixed").source == "solved"
+    assert spectral_basis(V, F, 10, weights="uniform").source == "solved"
+    V2 = V.copy()
+    V2[3, 0] += 1e-9
+    assert spectral_basis(V2, F, 10).source == "solved"
+    F2 = F[::-1].copy()  # the same triangles in another order: another key
+    assert spectral_basis(V, F2, 10).source == "solved"
+    assert len(list(spectral_cache_dir().glob("*.npz"))) == 5
+    # more pairs than stored: solved again, and the larger file replaces the smaller
+    spectral._MEMORY.clear()
+    assert spectral_basis(V, F, 20).source == "solved"
+    assert len(list(spectral_cache_dir().glob("*.npz"))) == 5
+
+
+def test_cache_false_touches_nothing(egg):
+    V, F = egg
+    spectral_basis(V, F, 10, cache=False)
+    assert not spectral_cache_dir().exists()
+    assert not spectral._MEMORY
+
+
+def test_cache_folder_choice(egg, tmp_path, monkeypatch):
+    V, F = egg
+    spectral_basis(V, F, 6, cache_dir=tmp_path / "mine")
+    assert len(list((tmp_path / "mine" / "spectral").glob("*.npz"))) == 1
+    monkeypatch.setattr(spectral, "CACHE_DIR", str(tmp_path / "attr"))
+    assert spectral_cache_dir() == tmp_path / "attr" / "spectral"
+    monkeypatch.setattr(spectral, "CACHE_DIR", None)
+    monkeypatch.delenv("GEOMLIB_CACHE_DIR")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    if not spectral.sys.platform.startswith(("win", "darwin")):
+        assert spectral_cache_dir() == tmp_path / "xdg" / "geomlib" / "spectral"
+    assert clear_spectral_cache(tmp_path / "mine") == 1
+
+
+def test_corrupt_cache_file_is_solved_again(egg):
+    V, F = egg
+    b = spectral_basis(V, F, 8)
+    (path,) = spectral_cache_dir().glob("*.npz")
+    path.write_bytes(b"not a numpy file")
+    spectral._MEMORY.clear()
+    b2 = spectral_basis(V, F, 8)
+    assert b2.source == "solved"
+    np.testing.assert_allclose(b2.lam, b.lam)
+
+
+def test_public_names():
+    for name in ("eigenbasis", "spectral_reconstruction", "spectral_basis", "SpectralBasis",
+                 "spectral_cache_dir", "clear_spectral_cache"):
+        assert name in geomlib.__all__ and callable(getattr(geomlib, name))
+
+
+# --------------------------------------------------------------------------
+# the course's armadillo (read from ../shared/meshes when present)
+
+
+@pytest.mark.skipif(not (COURSE / "decompose" / "armadillo.obj").exists(), reason="course meshes not present")
+def test_course_armadillo():
+    V, F = geomlib.load_mesh(COURSE / "decompose" / "armadillo.obj")
+    assert len(V) == 361
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MeshWarning)  # one component, no degenerate faces
+        ld, Ed = eigenbasis(V, F, 60, method="dense", cache=False)
+    ls, Es = eigenbasis(V, F, 60, method="sparse", cache=False)
+    np.testing.assert_allclose(ls, ld, rtol=1e-8, atol=1e-8)
+    m, C = _mass(V, F)
+    assert np.abs(Es.T @ (m[:, None] * Es) - np.eye(60)).max() < 1e-8
+    errors = [_rel_error(V, spectral_reconstruction(V, F, k), m) for k in (5, 15, 60, 200, 361)]
+    assert np.all(np.diff(errors) < 0)
+    assert errors[-1] < 1e-10
+
+
+def test_blas_thread_setting_is_restored(egg):
+    handles = spectral._openblas_handles()
+    before = [getter() for _, getter in handles]
+    with spectral._blas_threads(1):
+        assert all(getter() == 1 for _, getter in handles)
+    eigenbasis(*egg, 5, cache=False)
+    assert [getter() for _, getter in handles] == before
