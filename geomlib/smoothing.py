@@ -468,6 +468,94 @@ def _area(P, F):
     return 0.5 * float(np.linalg.norm(np.cross(P[F[:, 1]] - a, P[F[:, 2]] - a), axis=1).sum())
 
 
+#: Above this many unknowns the implicit system is ordered by geometric nested
+#: dissection before the LU factorisation (below it SuperLU's own COLAMD is as good).
+NESTED_DISSECTION_MIN = 4000
+
+
+def _nested_dissection(X, A, leaf=64):
+    """Fill-reducing ordering of a mesh matrix by geometric nested dissection.
+
+    Every part of more than ``leaf`` vertices is split at the median of its
+    longest bounding-box axis; the vertices of the lower half with a neighbour
+    (a nonzero of A) in the upper half form the separator, ordered after both
+    halves. On a surface mesh separators have O(sqrt(n)) vertices, so the
+    factors of ``M - step C`` fill in far less than with a column ordering
+    (about half the nonzeros and a third of the factorisation time of
+    SuperLU's COLAMD at 160k vertices). Vectorised one tree level at a time.
+
+    Returns the permutation ``p`` (new position -> vertex), i.e. use ``A[p][:, p]``.
+    """
+    n = len(X)
+    T = sp.triu(A, 1).tocoo()
+    ei, ej = T.row.astype(np.int64), T.col.astype(np.int64)
+    label = np.zeros(n, np.int64)   # the part a vertex is in (binary path)
+    key = np.zeros(n, np.int64)     # base-3 digits: 0 lower half, 1 upper half, 2 separator
+    active = np.ones(n, bool)
+    for _ in range(38):  # 3**38 < 2**63
+        key *= 3
+        idx = np.flatnonzero(active)
+        if len(idx) == 0:
+            break
+        _, inv, counts = np.unique(label[idx], return_inverse=True, return_counts=True)
+        big = counts[inv] > leaf
+        active[idx[~big]] = False
+        idx = idx[big]
+        if len(idx) == 0:
+            break
+        _, inv, counts = np.unique(inv[big], return_inverse=True, return_counts=True)
+        parts = len(counts)
+        P = X[idx]
+        lo = np.full((parts, 3), np.inf)
+        hi = np.full((parts, 3), -np.inf)
+        np.minimum.at(lo, inv, P)
+        np.maximum.at(hi, inv, P)
+        axis = np.argmax(hi - lo, axis=1)[inv]
+        coord = P[np.arange(len(idx)), axis]
+        order = np.lexsort((coord, inv))
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        rank = np.empty(len(idx), np.int64)
+        rank[order] = np.arange(len(idx)) - starts[inv[order]]
+        upper = (rank >= counts[inv] // 2).astype(np.int64)
+        side = np.full(n, -1, np.int64)
+        side[idx] = upper
+        part = np.full(n, -1, np.int64)
+        part[idx] = inv
+        cross = (part[ei] >= 0) & (part[ei] == part[ej]) & (side[ei] != side[ej])
+        a, b = ei[cross], ej[cross]
+        separator = np.unique(np.where(side[a] == 0, a, b))
+        key[idx] += upper
+        label[idx] = label[idx] * 2 + upper
+        key[separator] += 2
+        active[separator] = False
+    return np.argsort(key, kind="stable")
+
+
+class _SPDFactor:
+    """Sparse LU of a symmetric positive definite matrix, in a given symmetric order.
+
+    With an ordering ``perm`` SuperLU is told to keep it (natural column order,
+    symmetric mode, diagonal pivots: an SPD matrix needs no pivoting), so the
+    factor is the Cholesky-like one of ``A[perm][:, perm]``.
+    """
+
+    def __init__(self, A, perm=None):
+        self.perm = perm
+        if perm is None:
+            self.lu = sla.splu(A.tocsc())
+        else:
+            Ap = A.tocsr()[perm][:, perm].tocsc()
+            self.lu = sla.splu(Ap, permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                               options=dict(SymmetricMode=True))
+
+    def solve(self, B):
+        if self.perm is None:
+            return self.lu.solve(B)
+        X = np.empty_like(B)
+        X[self.perm] = self.lu.solve(np.ascontiguousarray(B[self.perm]))
+        return X
+
+
 class ImplicitSmoother:
     """Implicit smoothing with a fixed operator, factorisations cached per step.
 
@@ -478,18 +566,24 @@ class ImplicitSmoother:
     ``(M_II - step C_II) P'_I = M_I P_I + step C_IB P_B``.
 
     Meant for sliders: build it once outside the callback; every new step value
-    costs one sparse LU factorisation (scipy ``splu``), cached (the last
-    ``cache_size`` step values), and every iteration one pair of triangular
-    solves.
+    costs one sparse LU factorisation (scipy ``splu``, in a nested-dissection
+    order computed once), cached (the last ``cache_size`` step values), and
+    every iteration one pair of triangular solves. :meth:`smooth` also keeps
+    the iterates of the last ``history_size`` (step, keep_volume) settings, so
+    moving an iteration slider costs only the iterations not yet computed and
+    returning to a setting seen before costs nothing.
 
     Parameters
     ----------
     V, F, weights, area, boundary : as in :func:`implicit_smoothing`.
     cache_size : int
         How many factorisations to keep.
+    history_size : int
+        For how many settings to keep the iterates (0: none).
     """
 
-    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed", cache_size=16):
+    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed", cache_size=16,
+                 history_size=4):
         V, F = _as_mesh(V, F)
         _check_choice(weights, "weights", _WEIGHTS)
         _check_choice(boundary, "boundary", _BOUNDARY)
@@ -503,7 +597,17 @@ class ImplicitSmoother:
         self.C_II = C[self.I][:, self.I].tocsc()
         self.CP_B = C[self.I][:, B] @ V[B]  # C_IB P_B, constant while P_B stays fixed
         self.cache_size = int(cache_size)
+        self.history_size = int(history_size)
         self._lu = {}
+        self._history = {}
+        self._perm = None
+
+    @property
+    def perm(self):
+        """The fill-reducing order of the unknowns (None for small systems)."""
+        if self._perm is None and len(self.I) > NESTED_DISSECTION_MIN:
+            self._perm = _nested_dissection(self.V[self.I], self.C_II)
+        return self._perm
 
     def factor(self, step):
         """The LU factorisation of ``M_II - step C_II`` (cached)."""
@@ -513,7 +617,7 @@ class ImplicitSmoother:
         else:
             A = (sp.diags(self.m[self.I]) - step * self.C_II).tocsc()
             try:
-                lu = sla.splu(A)
+                lu = _SPDFactor(A, self.perm)
             except RuntimeError as exc:  # "Factor is exactly singular"
                 raise MeshError(f"implicit smoothing: the system M - {step:.6g} C is singular "
                                 f"({exc})") from None
@@ -532,29 +636,47 @@ class ImplicitSmoother:
 
     def smooth(self, step, iterations=1, keep_volume=False, progress=None, callback=None,
                P=None):
-        """Run ``iterations`` implicit steps from P (default: the positions given)."""
+        """Run ``iterations`` implicit steps from P (default: the positions given).
+
+        Returns a new (n, 3) array. Without P and callback the iterates are kept
+        (``history_size``) and a later call continues from the last one stored.
+        """
         step = _check_step(step)
         iterations = _check_iterations(iterations)
+        remember = P is None and callback is None and self.history_size > 0
         P = self.V.copy() if P is None else np.array(P, dtype=np.float64)
         if iterations == 0:
             return P
-        lu = self.factor(step)
         keeper = _VolumeKeeper(P, self.F) if keep_volume else None
-        bar = _Progress(iterations, progress, "implicit smoothing")
+        start = 0
+        if remember:
+            key = (step, bool(keep_volume))
+            history = self._history.pop(key, [])
+            self._history[key] = history  # most recently used last
+            while len(self._history) > self.history_size:
+                self._history.pop(next(iter(self._history)))
+            if len(history) >= iterations:
+                return history[iterations - 1].copy()
+            if history:
+                start, P = len(history), history[-1]
+        lu = self.factor(step)
+        bar = _Progress(iterations - start, progress, "implicit smoothing")
         try:
-            for k in range(1, iterations + 1):
+            for k in range(start + 1, iterations + 1):
                 P = self.step_once(P, step, lu)
                 if keeper is not None:
                     try:
                         P = keeper(P, k)
                     except _Collapse as exc:
                         raise MeshError(f"implicit smoothing stopped: {exc}") from None
+                if remember:
+                    history.append(P)
                 if callback is not None:
                     callback(k, P)
-                bar.step(k)
+                bar.step(k - start)
         finally:
             bar.close()
-        return P
+        return P.copy() if remember else P
 
 
 class _VolumeKeeper:
@@ -661,7 +783,7 @@ def implicit_smoothing(V, F, step, iterations=1, weights="cotan", *, area="baryc
         return V.copy()
 
     if not rebuild and solver == "lu":
-        smoother = ImplicitSmoother(V, F, weights, area, boundary, cache_size=1)
+        smoother = ImplicitSmoother(V, F, weights, area, boundary, cache_size=1, history_size=0)
         lu = smoother.factor(step)
         advance = lambda P: smoother.step_once(P, step, lu)  # noqa: E731
     elif not rebuild:
@@ -729,6 +851,7 @@ class _RebuiltStep:
         self.V0, self.F = V, F
         self.weights, self.area, self.boundary, self.step = weights, area, boundary, step
         self.k = 0
+        self.perm, self.I = None, None
 
     def __call__(self, P):
         self.k += 1
@@ -744,9 +867,12 @@ class _RebuiltStep:
         C_II = C[I][:, I]
         A = (sp.diags(m[I]) - self.step * C_II).tocsc()
         rhs = m[I, None] * P[I] + self.step * (C[I][:, B] @ P[B])
+        if len(I) > NESTED_DISSECTION_MIN and (self.I is None or not np.array_equal(I, self.I)):
+            # the sparsity pattern does not change with the positions: order once
+            self.I, self.perm = I, _nested_dissection(P[I], C_II)
         Q = P.copy()
         try:
-            Q[I] = sla.splu(A).solve(rhs)
+            Q[I] = _SPDFactor(A, self.perm if len(I) > NESTED_DISSECTION_MIN else None).solve(rhs)
         except RuntimeError as exc:
             raise _Collapse(f"the matrix M - step C became singular at iteration {self.k} "
                             f"({exc})") from None

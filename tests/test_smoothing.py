@@ -384,3 +384,33 @@ def test_course_noisy_plane():
     Q = explicit_smoothing(V, F, step_fraction=0.9, iterations=50)
     assert roughness(P) < 0.5 * roughness(V)
     assert roughness(Q) < 0.5 * roughness(V)
+
+
+def test_nested_dissection_order_solves_exactly():
+    from geomlib.smoothing import NESTED_DISSECTION_MIN, _nested_dissection
+
+    V, F = icosphere(5)  # 10242 vertices: the reordered factorisation is used
+    assert len(V) > NESTED_DISSECTION_MIN
+    V = V + 0.01 * np.random.default_rng(10).standard_normal(V.shape)
+    M, C = laplacian(V, F)
+    p = _nested_dissection(V, C)
+    assert np.array_equal(np.sort(p), np.arange(len(V)))
+    step = 0.001
+    P = sla.spsolve((M - step * C).tocsc(), M @ V)
+    np.testing.assert_allclose(implicit_smoothing(V, F, step, 1), P, rtol=0, atol=1e-10)
+
+
+def test_smoother_history_matches_fresh_runs():
+    V, F = icosphere(3)
+    V = V + 0.02 * np.random.default_rng(11).standard_normal(V.shape)
+    S = ImplicitSmoother(V, F)
+    five = S.smooth(0.05, 5)
+    three = S.smooth(0.05, 3)  # from the stored iterates
+    seven = S.smooth(0.05, 7)  # continues from the fifth
+    np.testing.assert_allclose(three, implicit_smoothing(V, F, 0.05, 3), atol=1e-14)
+    np.testing.assert_allclose(seven, implicit_smoothing(V, F, 0.05, 7), atol=1e-14)
+    three[:] = 0.0  # a returned array is the caller's
+    np.testing.assert_allclose(S.smooth(0.05, 3), implicit_smoothing(V, F, 0.05, 3), atol=1e-14)
+    vol0 = _volume_centroid(V, F)[0]
+    assert abs(_volume_centroid(S.smooth(0.05, 4, keep_volume=True), F)[0] / vol0 - 1) < 1e-12
+    assert not np.allclose(five, S.smooth(0.05, 5, keep_volume=True))
