@@ -27,7 +27,15 @@ opposite its longest edge, 0 at the others), so Gauss-Bonnet stays exact; at a
 non-manifold vertex (several fans of triangles) the deficit is
 ``2 pi - sum theta`` over all its triangles, which keeps the total equal to
 ``2 pi chi`` of the mesh as given but is not a pointwise curvature estimate;
-edges with three or more triangles are reported and counted as interior.
+edges with three or more triangles count as interior and are reported when
+they unbalance the orientation around a vertex (always so for an odd number of
+triangles; ``geomlib.check_mesh`` lists them all).
+
+Memory: ``gaussian_curvature`` works through the faces in blocks, so its peak
+memory is O(n) plus one block (about libigl's footprint), and it finds boundary
+vertices with two exact integer sums per vertex instead of an edge table
+(see ``_deficits_and_probes``); only vertices the sums flag get the exact edge
+count.
 """
 
 import warnings
@@ -110,7 +118,7 @@ def _edge_list(E, limit=5):
 def boundary_mask(V, F):
     """Boolean (n,): True at vertices of an edge that belongs to exactly one triangle."""
     V, F = _as_mesh(V, F)
-    return _edge_counts(F, len(V))[0] > 0
+    return _boundary_mask(F, len(V))
 
 
 def _warn(message, stacklevel=3):
@@ -176,7 +184,7 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
     else:
         H = 0.5 * np.sqrt(np.einsum("ij,ij->i", DV, DV))
     if boundary != "formula":
-        on_boundary = _edge_counts(F, len(V))[0] > 0
+        on_boundary = _boundary_mask(F, len(V))
         H[on_boundary] = np.nan if boundary == "nan" else 0.0
     return H
 
@@ -207,6 +215,70 @@ def angle_sums(V, F):
     l2, dblA, _, degenerate = _geometry(V, F)
     theta = _angles(l2, dblA, degenerate)
     return np.bincount(F.T.ravel(), weights=theta.ravel(), minlength=len(V))
+
+
+#: Faces per block in gaussian_curvature: the per-face temporaries are allocated
+#: one block at a time, so the peak memory stays O(n) plus one block.
+BLOCK_FACES = 1 << 15
+
+
+def _block_size(m):
+    return int(min(max(m // 16, 4096), 4 * BLOCK_FACES))
+
+
+def _deficits_and_probes(V, F, n, area):
+    """Angle sums, vertex areas (or None) and two boundary probes, block by block.
+
+    The probes: every corner (v; next, prev) of a face adds ``next - prev``
+    (probe 1) and ``next^2 - prev^2`` (probe 2) to vertex v, in exact integer
+    arithmetic carried in float64 (exact below 2^53, so for n < 9e7). Around
+    an interior vertex of a consistently oriented manifold every neighbour is
+    once "next" and once "prev", and both probes are exactly 0; an open fan
+    leaves ``end - start`` != 0. So a vertex with both probes 0 has no
+    boundary edge (unless several open fans meet there in a pattern that
+    cancels both sums), and every vertex with a non-zero probe is checked
+    exactly afterwards, so nothing is ever classified as boundary wrongly.
+    """
+    m = len(F)
+    theta_sum = np.zeros(n)
+    A = np.zeros(n) if area is not None else None
+    p1 = np.zeros(n)
+    p2 = np.zeros(n)
+    any_degenerate = False
+    step = _block_size(m)
+    columns = (V[:, 0], V[:, 1], V[:, 2])  # strided views: no copy of V per block
+    for start in range(0, m, step):
+        Fb = F[start:start + step]
+        l2, dblA, cot, degenerate = _geometry(V, Fb, columns)
+        any_degenerate |= bool(degenerate.any())
+        theta = _angles(l2, dblA, degenerate)
+        Ft = Fb.T
+        idx = Ft.ravel()
+        theta_sum += np.bincount(idx, weights=theta.ravel(), minlength=n)
+        if A is not None:
+            A += _vertex_areas(n, Fb, l2, dblA, cot, area, degenerate)
+        del l2, dblA, cot, theta
+        Ff = Ft.astype(np.float64)
+        diff = Ff[[1, 2, 0]] - Ff[[2, 0, 1]]  # next - prev at each corner
+        p1 += np.bincount(idx, weights=diff.ravel(), minlength=n)
+        diff *= Ff[[1, 2, 0]] + Ff[[2, 0, 1]]  # next^2 - prev^2
+        p2 += np.bincount(idx, weights=diff.ravel(), minlength=n)
+        del Ff, diff
+    return theta_sum, A, (p1 != 0) | (p2 != 0), any_degenerate
+
+
+def _boundary_counts(F, n, candidates):
+    """Exact boundary-edge counts (n,) and non-manifold edges, checking only the
+    faces at candidate vertices (all edges at a candidate vertex are among them)."""
+    b = np.zeros(n, np.int64)
+    if not candidates.any():
+        return b, np.empty((0, 2), np.int64)
+    Fc = F[candidates[F].any(axis=1)]
+    bc, nonmanifold = _edge_counts(Fc, n)
+    b[candidates] = bc[candidates]
+    if len(nonmanifold):
+        nonmanifold = nonmanifold[candidates[nonmanifold].any(axis=1)]
+    return b, nonmanifold
 
 
 def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=False):
@@ -260,11 +332,16 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
         raise MeshError(f"boundary must be one of {BOUNDARY_RULES}, not {boundary!r}")
     V, F = _as_mesh(V, F)
     n = len(V)
-    l2, dblA, cot, degenerate = _geometry(V, F)
-    theta = _angles(l2, dblA, degenerate)
-    deficit = 2.0 * np.pi - np.bincount(F.T.ravel(), weights=theta.ravel(), minlength=n)
+    # block-wise: peak memory O(n) plus one block of faces (libigl-like footprint)
+    theta_sum, A, candidates, any_degenerate = _deficits_and_probes(V, F, n, None if integrated else area)
+    deficit = np.subtract(2.0 * np.pi, theta_sum, out=theta_sum)
+    if any_degenerate:
+        _l2, _dblA, _cot, degenerate = _geometry(V, F)
+        _warn(f"{degenerate.sum()} zero-area triangle(s) count as flat (angle pi opposite the longest "
+              f"edge) and add no area: faces {format_indices(np.flatnonzero(degenerate))}")
+        del _l2, _dblA, _cot
     if boundary != "deficit":
-        b, nonmanifold = _edge_counts(F, n)
+        b, nonmanifold = _boundary_counts(F, n, candidates)
         on_boundary = b > 0
         if len(nonmanifold):
             _warn(f"{len(nonmanifold)} edge(s) belong to three or more triangles; they count as "
@@ -286,13 +363,12 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
             _warn(f"{(~referenced).sum()} vertex/vertices are in no triangle; K is NaN there: "
                   f"vertices {format_indices(np.flatnonzero(~referenced))}")
         return deficit
-    A = _vertex_areas(n, F, l2, dblA, cot, area, degenerate)
     no_area = A <= 0
     if no_area.any():
         _warn(f"{no_area.sum()} vertex/vertices have zero area (in no triangle of non-zero area); "
               f"K is NaN there: vertices {format_indices(np.flatnonzero(no_area))}")
-        A = np.where(no_area, np.nan, A)
-    return deficit / A
+        A[no_area] = np.nan
+    return np.divide(deficit, A, out=deficit)
 
 
 def principal_curvatures(H, K):
@@ -312,4 +388,11 @@ def principal_curvatures(H, K):
 
 def _boundary_mask(F, n):
     """Vertices on an edge used by exactly one face (boolean (n,))."""
-    return _edge_counts(np.asarray(F), n)[0] > 0
+    F = np.asarray(F)
+    Ft = F.T
+    idx = Ft.ravel()
+    nxt = Ft[[1, 2, 0]].ravel().astype(np.float64)
+    prv = Ft[[2, 0, 1]].ravel().astype(np.float64)
+    candidates = (np.bincount(idx, weights=nxt - prv, minlength=n) != 0) | (
+        np.bincount(idx, weights=(nxt - prv) * (nxt + prv), minlength=n) != 0)
+    return _boundary_counts(F, n, candidates)[0] > 0

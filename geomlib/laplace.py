@@ -76,13 +76,15 @@ def _check_options(weights=None, area=None):
         raise MeshError(f"area must be 'barycentric' or 'mixed', not {area!r}")
 
 
-def _geometry(V, F):
+def _geometry(V, F, columns=None):
     """Face geometry in (3, m) layout (one row per corner): l2, dblA, cot, degenerate.
 
     Computed coordinate by coordinate on contiguous arrays (no np.cross, no
     (m, 3) temporaries), which is what makes the assembly as fast as libigl's.
+    ``columns`` = (X, Y, Z) coordinate arrays (views are fine) when the caller
+    processes the faces block by block and wants to avoid a copy per block.
     """
-    X, Y, Z = np.ascontiguousarray(V.T)
+    X, Y, Z = np.ascontiguousarray(V.T) if columns is None else columns
     i0, i1, i2 = np.ascontiguousarray(F.T)
     x0, x1, x2 = X[i0], X[i1], X[i2]
     y0, y1, y2 = Y[i0], Y[i1], Y[i2]
