@@ -330,3 +330,19 @@ def test_libigl_gaussian_curvature_course(name):
     # Gauss-Bonnet with the turning angle on every course mesh, open or closed
     total = gaussian_curvature(V, F, boundary="turning", integrated=True)
     assert abs(np.nansum(total) - 2 * np.pi * euler_characteristic(V, F)) < 1e-9
+
+
+def test_boundary_detection_ignores_orientation_flips():
+    # flipping faces unbalances the boundary probes at their vertices; the exact
+    # check that follows must still find no boundary on a closed mesh
+    m = surfaces.ellipsoid(1.0, 0.7, 0.5, 3, jitter=0.3, seed=4)
+    F = m.F.copy()
+    F[::7] = F[::7, ::-1]
+    assert not boundary_mask(m.V, F).any()
+    np.testing.assert_allclose(gaussian_curvature(m.V, F), gaussian_curvature(m.V, m.F), rtol=1e-12)
+    # and an open mesh keeps exactly its boundary
+    s = surfaces.saddle(n=9)
+    Fs = s.F.copy()
+    Fs[1::3] = Fs[1::3, ::-1]
+    np.testing.assert_array_equal(boundary_mask(s.V, Fs), boundary_mask(s.V, s.F))
+    assert boundary_mask(s.V, s.F).sum() == 4 * 9
