@@ -15,6 +15,9 @@ draw on a canvas it records the time of the next animation frame (the frame
 that shows the draw). A keydown listener records the key press. After each
 press the script waits until the kernel is idle and the canvas has drawn
 nothing for 0.8 s; the latency is the last recorded frame minus the key press.
+The arrival of the large websocket messages (the buffer updates) is recorded
+too, which splits the time into kernel + transfer and browser-side work
+(decoding, upload to the GPU, drawing with software WebGL).
 
 The reference in the same run ("naive") is the straightforward pythreejs
 version: three separate BufferAttributes (three messages per update),
@@ -99,6 +102,19 @@ INIT_SCRIPT = r'''
 (() => {
   window.__frames = [];
   window.__key = 0;
+  window.__messages = [];
+  // arrival of large websocket messages (the buffer updates), before Lab handles them
+  const NativeWebSocket = window.WebSocket;
+  window.WebSocket = class extends NativeWebSocket {
+    constructor(...args) {
+      super(...args);
+      this.binaryType = 'arraybuffer';
+      this.addEventListener('message', (e) => {
+        const size = e.data && (e.data.byteLength || e.data.size || e.data.length || 0);
+        if (size > 20000) window.__messages.push({t: performance.now(), size});
+      });
+    }
+  };
   document.addEventListener('keydown', () => { window.__key = performance.now(); }, true);
   const pending = new WeakSet();
   for (const proto of [WebGLRenderingContext.prototype,
@@ -124,7 +140,11 @@ JS_LAST_FRAME = r'''
   const canvas = document.querySelector(sel + ' .geomlib-canvas canvas');
   const key = window.__key;
   const mine = window.__frames.filter(f => f.canvas === canvas && f.t >= key);
-  return {key, n: mine.length, last: mine.length ? mine[mine.length - 1].t : null, now: performance.now()};
+  const msgs = window.__messages.filter(m => m.t >= key);
+  return {key, n: mine.length, last: mine.length ? mine[mine.length - 1].t : null,
+          messages: msgs.length, first_message: msgs.length ? msgs[0].t : null,
+          last_message: msgs.length ? msgs[msgs.length - 1].t : null,
+          bytes: msgs.reduce((a, m) => a + m.size, 0), now: performance.now()};
 }
 '''
 
@@ -166,7 +186,7 @@ def measure(page, selector, reps, settle=0.8, timeout=30.0):
     canvas = page.locator(f"{selector} .geomlib-canvas").first
     before = canvas.screenshot()
     handle.focus()
-    latencies = []
+    latencies, arrivals, messages = [], [], []
     changed = None
     for r in range(reps):
         key = "ArrowRight" if (r // 5) % 2 == 0 else "ArrowLeft"   # stay inside the slider's range
@@ -184,9 +204,12 @@ def measure(page, selector, reps, settle=0.8, timeout=30.0):
         if last_seen is None:
             raise RuntimeError(f"{selector}: no frame drawn after the key press")
         latencies.append(last_seen - info["key"])
+        if info["first_message"] is not None:
+            arrivals.append(info["last_message"] - info["key"])
+            messages.append((info["messages"], info["bytes"]))
         if changed is None:
             changed = lablib.changed_fraction(before, canvas.screenshot())
-    return latencies, changed
+    return latencies, changed, arrivals, messages
 
 
 def main():
@@ -220,11 +243,15 @@ def main():
             for variant in variants:
                 for level, n, target in SIZES:
                     sel = f".bench-{variant}-{n}"
-                    lat, changed = measure(page, sel, args.reps)
+                    lat, changed, arrivals, messages = measure(page, sel, args.reps)
                     results[(variant, n)] = statistics.median(lat)
+                    arrive = f"{statistics.median(arrivals):.0f}" if arrivals else "?"
+                    count, size = messages[len(messages) // 2] if messages else (0, 0)
                     print(f"{variant:8s} {n:7d} vertices: median {statistics.median(lat):6.0f} ms "
-                          f"(min {min(lat):.0f}, max {max(lat):.0f}, {len(lat)} presses; "
-                          f"{changed:.0%} of the canvas changed)", flush=True)
+                          f"(min {min(lat):.0f}, max {max(lat):.0f}, {len(lat)} presses); "
+                          f"last update message in the browser after {arrive} ms "
+                          f"({count} large message(s), {size / 1e6:.1f} MB); "
+                          f"{changed:.0%} of the canvas changed", flush=True)
             lablib.shutdown_kernel(page)
 
     print("\nkey press -> final image, median ms")

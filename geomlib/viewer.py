@@ -28,6 +28,13 @@ e.g. ``VBox([slider, view.widget])`` or ``VBox([HBox([s1, s2]), side_by_side(a, 
 and checks that the picture of that box changes. A notebook needs at least one
 such box. Sliders displayed elsewhere are not moved by the test.
 
+Many views on one page
+----------------------
+pythreejs keeps at most 8 live WebGL canvases per page; when a ninth view
+appears, the oldest one is frozen into a picture and comes back to life when
+the mouse enters it. Keep notebooks to about 8 views, or reuse one view with
+``update``.
+
 Updates
 -------
 ``view.update(V=..., values=...)`` overwrites the buffers in place: positions,
@@ -81,6 +88,8 @@ VIEWS = {
 UP, VIEW_DIRECTION = VIEWS["z"]
 #: vertical field of view of the camera in degrees
 FOV = 30.0
+#: multisampled edges; set False before making views to trade smooth edges for speed
+ANTIALIAS = True
 
 _VERTEX_SHADER = """
 varying vec3 vColor;
@@ -596,7 +605,7 @@ class MeshView:
             quaternion=_look_at_quaternion(self._direction, self._up), up=self._up)
         self.controls = three.OrbitControls(controlling=self.camera, target=(0.0, 0.0, 0.0))
         self.renderer = three.Renderer(camera=self.camera, scene=self.scene, controls=[self.controls],
-                                       width=self.width, height=self.height, antialias=True)
+                                       width=self.width, height=self.height, antialias=ANTIALIAS)
         self.renderer.add_class("geomlib-canvas")
 
         self._title = widgets.HTML(
