@@ -24,9 +24,14 @@ Marking views and sliders (the browser tests rely on it)
 Every ``MeshView.widget`` carries the CSS class ``geomlib-view`` and its
 canvas the class ``geomlib-canvas``. The browser test moves, in every notebook,
 the first slider that sits in the same ipywidgets box as a view (at any depth,
-e.g. ``VBox([slider, view.widget])`` or ``VBox([HBox([s1, s2]), side_by_side(a, b).widget])``)
-and checks that the picture of that box changes. A notebook needs at least one
-such box. Sliders displayed elsewhere are not moved by the test.
+e.g. ``VBox([slider, view.widget])`` or ``VBox([HBox([s1, s2]), side_by_side(a, b).widget])``);
+if there is none, the first slider displayed by the same cell as a view
+(``display(slider); display(view)``). It checks that the views of that box or
+cell change. So a notebook needs at least one slider next to a view in one of
+these two ways, and that slider must change the picture whether it is moved to
+its maximum (or to its minimum when it starts there). Sliders elsewhere are
+not moved by the test. Views shown with ``side_by_side`` are also checked for
+linked cameras (an orbit drag in the first view must turn the second).
 
 Many views on one page
 ----------------------

@@ -204,28 +204,34 @@ async () => {
 }
 """
 
-# find the first slider that shares an ipywidgets box with a geomlib view;
-# mark it (data-geomlib-slider) and the box (data-geomlib-box)
+# find the first slider that shares an ipywidgets box with a geomlib view, or
+# failing that, the first slider displayed by the same cell as a view; mark it
+# (data-geomlib-slider) and the box or output area (data-geomlib-box)
 JS_FIND_SLIDER = """
 () => {
   const sliders = [...document.querySelectorAll('.jp-Notebook .widget-slider')];
+  const mark = (s, el, how) => {
+    document.querySelectorAll('[data-geomlib-slider]').forEach(e => e.removeAttribute('data-geomlib-slider'));
+    document.querySelectorAll('[data-geomlib-box]').forEach(e => e.removeAttribute('data-geomlib-box'));
+    s.setAttribute('data-geomlib-slider', '1');
+    el.setAttribute('data-geomlib-box', '1');
+    const h = s.querySelector('.noUi-handle');
+    return {found: true, how, count: el.querySelectorAll('.geomlib-view').length,
+            now: h ? Number(h.getAttribute('aria-valuenow')) : null,
+            max: h ? Number(h.getAttribute('aria-valuemax')) : null,
+            min: h ? Number(h.getAttribute('aria-valuemin')) : null,
+            description: (s.querySelector('.widget-label') || {}).textContent || ''};
+  };
   for (const s of sliders) {
     let el = s.parentElement;
     while (el && !el.classList.contains('jp-OutputArea-output')) {
-      if (el.classList.contains('widget-box') && el.querySelector('.geomlib-view')) {
-        document.querySelectorAll('[data-geomlib-slider]').forEach(e => e.removeAttribute('data-geomlib-slider'));
-        document.querySelectorAll('[data-geomlib-box]').forEach(e => e.removeAttribute('data-geomlib-box'));
-        s.setAttribute('data-geomlib-slider', '1');
-        el.setAttribute('data-geomlib-box', '1');
-        const h = s.querySelector('.noUi-handle');
-        return {found: true, count: el.querySelectorAll('.geomlib-view').length,
-                now: h ? Number(h.getAttribute('aria-valuenow')) : null,
-                max: h ? Number(h.getAttribute('aria-valuemax')) : null,
-                min: h ? Number(h.getAttribute('aria-valuemin')) : null,
-                description: (s.querySelector('.widget-label') || {}).textContent || ''};
-      }
+      if (el.classList.contains('widget-box') && el.querySelector('.geomlib-view')) return mark(s, el, 'box');
       el = el.parentElement;
     }
+  }
+  for (const s of sliders) {
+    const area = s.closest('.jp-OutputArea');
+    if (area && area.querySelector('.geomlib-view')) return mark(s, area, 'cell');
   }
   return {found: false};
 }

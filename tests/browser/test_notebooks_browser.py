@@ -5,8 +5,9 @@ For each notebooks/*.ipynb (new notebooks are picked up automatically):
 1. open it, run all cells, wait until every code cell has run and the kernel is idle;
 2. no cell has an error output (stderr text such as tqdm's progress bars is fine);
 3. every 3D view (``.geomlib-canvas``) shows a picture: not one flat colour;
-4. the first slider sharing an ipywidgets box with a view (see the convention
-   in geomlib/viewer.py) is moved with the keyboard and the picture changes;
+4. the first slider sharing an ipywidgets box with a view, or else displayed
+   by the same cell as a view (the convention is in geomlib/viewer.py), is
+   moved with the keyboard and the picture changes;
 5. where views are shown with ``side_by_side``, an orbit drag in the first one
    also turns the second (linked cameras).
 
@@ -87,8 +88,8 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         # 4: a slider beside a view changes the picture
         found = page.evaluate(lablib.JS_FIND_SLIDER)
         assert found["found"], (
-            f"{notebook}: no slider shares an ipywidgets box with a view; put them in one box, "
-            "e.g. ipywidgets.VBox([slider, view.widget]) (see geomlib/viewer.py)")
+            f"{notebook}: no slider shares an ipywidgets box or a cell with a view; put them in one box, "
+            "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/viewer.py)")
         box_canvases = page.locator("[data-geomlib-box] .geomlib-canvas")
         before = [box_canvases.nth(i).screenshot() for i in range(box_canvases.count())]
         handle = page.locator("[data-geomlib-slider] .noUi-handle").first
