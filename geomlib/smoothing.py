@@ -473,7 +473,7 @@ def _area(P, F):
 NESTED_DISSECTION_MIN = 4000
 
 
-def _nested_dissection(X, A, leaf=64):
+def _nested_dissection(X, A, leaf=32):
     """Fill-reducing ordering of a mesh matrix by geometric nested dissection.
 
     Every part of more than ``leaf`` vertices is split at the median of its
@@ -504,16 +504,14 @@ def _nested_dissection(X, A, leaf=64):
         if len(idx) == 0:
             break
         _, inv, counts = np.unique(inv[big], return_inverse=True, return_counts=True)
-        parts = len(counts)
         P = X[idx]
-        lo = np.full((parts, 3), np.inf)
-        hi = np.full((parts, 3), -np.inf)
-        np.minimum.at(lo, inv, P)
-        np.maximum.at(hi, inv, P)
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        by_part = np.argsort(inv, kind="stable")
+        lo = np.minimum.reduceat(P[by_part], starts, axis=0)
+        hi = np.maximum.reduceat(P[by_part], starts, axis=0)
         axis = np.argmax(hi - lo, axis=1)[inv]
         coord = P[np.arange(len(idx)), axis]
         order = np.lexsort((coord, inv))
-        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         rank = np.empty(len(idx), np.int64)
         rank[order] = np.arange(len(idx)) - starts[inv[order]]
         upper = (rank >= counts[inv] // 2).astype(np.int64)
