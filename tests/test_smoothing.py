@@ -414,3 +414,15 @@ def test_smoother_history_matches_fresh_runs():
     vol0 = _volume_centroid(V, F)[0]
     assert abs(_volume_centroid(S.smooth(0.05, 4, keep_volume=True), F)[0] / vol0 - 1) < 1e-12
     assert not np.allclose(five, S.smooth(0.05, 5, keep_volume=True))
+
+
+def test_progress_bar_appears_for_long_runs(monkeypatch, capsys):
+    import geomlib.smoothing as smoothing
+
+    V, F = icosphere(2)
+    monkeypatch.setattr(smoothing, "PROGRESS_SECONDS", 0.0)  # every run counts as long
+    implicit_smoothing(V, F, 0.01, 3)
+    assert "implicit smoothing" in capsys.readouterr().err
+    monkeypatch.setattr(smoothing, "PROGRESS_SECONDS", 1e9)  # no run does
+    explicit_smoothing(V, F, 1e-4, 3)
+    assert capsys.readouterr().err == ""
