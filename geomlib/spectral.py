@@ -240,15 +240,28 @@ def _disk_store(folder, key, lam, E):
 # BLAS threads
 
 
+_HANDLES = {}
+
+
 def _openblas_handles():
-    """(set, get) function pairs of every OpenBLAS loaded in this process (Linux only; else [])."""
-    handles = []
+    """(set, get) function pairs of every OpenBLAS loaded in this process (Linux only; else []).
+
+    Looked up once per set of loaded libraries (a module imported later may load another one)."""
     try:
         with open("/proc/self/maps") as maps:
-            paths = {line.split()[-1] for line in maps if "openblas" in line.rsplit("/", 1)[-1].lower()}
+            paths = tuple(sorted({line.split()[-1] for line in maps
+                                  if "openblas" in line.rsplit("/", 1)[-1].lower()}))
     except OSError:
-        return handles
-    for path in sorted(paths):
+        return []
+    if paths not in _HANDLES:
+        _HANDLES.clear()
+        _HANDLES[paths] = _load_handles(paths)
+    return _HANDLES[paths]
+
+
+def _load_handles(paths):
+    handles = []
+    for path in paths:
         try:
             lib = ctypes.CDLL(path)
         except OSError:
@@ -490,8 +503,9 @@ class SpectralBasis:
     def reconstruct(self, X, k=None):
         """``E_k E_k^T M X``: the M-orthogonal projection of X onto the first k eigenvectors."""
         k = self._k(k)
-        c = self.coefficients(X)
-        return self.E[:, :k] @ c[:k]
+        with _blas_threads(BLAS_THREADS):
+            c = self.coefficients(X)
+            return self.E[:, :k] @ c[:k]
 
     def residual_norms(self, X):
         """``||X - X_k||_M`` for k = 1 .. self.k, from the coefficients alone (Parseval).
