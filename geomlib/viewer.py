@@ -93,8 +93,12 @@ VIEWS = {
 UP, VIEW_DIRECTION = VIEWS["z"]
 #: vertical field of view of the camera in degrees
 FOV = 30.0
-#: multisampled edges; set False before making views to trade smooth edges for speed
-ANTIALIAS = True
+#: multisampled (smooth) edges: True, False, or "auto" = only for meshes of at
+#: most ANTIALIAS_MAX_VERTICES vertices. Without a GPU (software WebGL) the
+#: multisampling costs noticeable time per frame on large meshes, whose small
+#: triangles need it least.
+ANTIALIAS = "auto"
+ANTIALIAS_MAX_VERTICES = 20_000
 
 _VERTEX_SHADER = """
 varying vec3 vColor;
@@ -297,6 +301,23 @@ def vertex_normals_fast(V, F, S=None):
 # ----------------------------------------------------------------------------
 # camera and the still picture
 # ----------------------------------------------------------------------------
+
+def _closed_outward(V, F):
+    """True when every directed edge (i, j) has its reverse (j, i): a closed,
+    consistently oriented mesh, and its enclosed volume is positive (faces
+    counter-clockwise from outside). Then back faces can never be seen from
+    outside and the renderer may skip them."""
+    n = np.int64(V.shape[0])
+    i, j = F.ravel(), F[:, [1, 2, 0]].ravel()
+    key = np.sort(i * n + j)
+    if key.size > 1 and (key[1:] == key[:-1]).any():
+        return False                      # an edge used twice in the same direction
+    reverse = np.sort(j * n + i)
+    if not np.array_equal(key, reverse):
+        return False                      # a boundary, or orientation flips somewhere
+    p0, p1, p2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    return float(np.einsum("ij,ij->", p0, np.cross(p1, p2))) > 0
+
 
 def _frame(V):
     """Bounding-box centre and half diagonal of V."""
@@ -584,9 +605,14 @@ class MeshView:
         index = three.BufferAttribute(array=self._F.astype(np.uint32).ravel(), normalized=False)
         self.geometry = three.BufferGeometry(index=index, attributes={
             "position": position, "normal": normal, "color": color})
+        # closed outward meshes: back faces are hidden anyway and skipping them
+        # halves the software rasteriser's work; open or inconsistently oriented
+        # meshes show both sides
+        self.closed = _closed_outward(V, self._F)
         material = three.ShaderMaterial(
             vertexShader=_VERTEX_SHADER, fragmentShader=_FRAGMENT_SHADER,
-            vertexColors="VertexColors", side="DoubleSide", lights=False, fog=False,
+            vertexColors="VertexColors", side="FrontSide" if self.closed else "DoubleSide",
+            lights=False, fog=False,
             polygonOffset=True, polygonOffsetFactor=1.0, polygonOffsetUnits=1.0)
         self.mesh = three.Mesh(geometry=self.geometry, material=material)
         children = [self.mesh]
@@ -609,8 +635,9 @@ class MeshView:
             position=tuple(float(x) for x in _basis(self._direction, self._up)[2] * self._distance),
             quaternion=_look_at_quaternion(self._direction, self._up), up=self._up)
         self.controls = three.OrbitControls(controlling=self.camera, target=(0.0, 0.0, 0.0))
+        antialias = (self._n <= ANTIALIAS_MAX_VERTICES) if ANTIALIAS == "auto" else bool(ANTIALIAS)
         self.renderer = three.Renderer(camera=self.camera, scene=self.scene, controls=[self.controls],
-                                       width=self.width, height=self.height, antialias=ANTIALIAS)
+                                       width=self.width, height=self.height, antialias=antialias)
         self.renderer.add_class("geomlib-canvas")
 
         self._title = widgets.HTML(

@@ -314,3 +314,13 @@ def test_values_of_wrong_length(sphere):
         MeshView(V, F, values=V[:, 0], cmap="no-such-map")
     with pytest.raises(MeshError, match="MeshView"):
         side_by_side(view, "not a view")
+
+
+def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
+    V, F = sphere
+    assert MeshView(V, F).mesh.material.side == "FrontSide"
+    assert MeshView(V, F[:, ::-1]).mesh.material.side == "DoubleSide"      # inside out
+    G = F.copy()
+    G[0] = G[0, ::-1]                                                       # one face flipped
+    assert MeshView(V, G).mesh.material.side == "DoubleSide"
+    assert MeshView(V, F[1:]).mesh.material.side == "DoubleSide"            # a hole
