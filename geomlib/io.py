@@ -62,7 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import MeshError, MeshWarning, format_indices
-from .validate import as_mesh, as_vertices, check_mesh
+from .validate import _count, as_mesh, as_vertices, check_mesh
 
 __all__ = ["load_mesh", "save_mesh", "SUPPORTED_EXTENSIONS"]
 
@@ -256,28 +256,30 @@ def _obj_slow(data, where):
 # polygons -> triangles, with file-level checks
 
 
-def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None, line_word="line"):
+def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
     """Resolve file indices, check them with line numbers, fan-triangulate.
 
     ``idx`` holds the corner indices as written; ``sizes`` the corners per
-    polygon; ``lines`` the line number of each polygon.
+    polygon; ``lines`` the line number of each polygon. Faces are named by
+    their 0-based row in the returned F (a polygon by its first triangle).
     """
     if len(sizes) == 0:
         return np.zeros((0, 3), np.int64)
     small = np.flatnonzero(sizes < 3)
     if len(small):
         p = small[0]
-        raise MeshError(
-            f"{where}: {line_word} {lines[p]}: a face needs at least 3 vertex indices, found {sizes[p]}"
-            + (f" (and {len(small) - 1} more such faces, lines {format_indices(lines[small[1:]])})" if len(small) > 1 else "")
-        )
+        more = f" (and {_count(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})" if len(small) > 1 else ""
+        raise MeshError(f"{where}: line {lines[p]}: a face needs at least 3 vertex indices, found {sizes[p]}{more}")
+    ntri = sizes - 2
+    first_tri = np.cumsum(ntri) - ntri  # row in F of each polygon's first triangle
     poly = np.repeat(np.arange(len(sizes)), sizes)
     if one_based:
         zero = np.flatnonzero(idx == 0)
         if len(zero):
+            others = np.unique(lines[poly[zero]])[1:]
+            more = f"; also on lines {format_indices(others)}" if len(others) else ""
             raise MeshError(
-                f"{where}: {line_word} {lines[poly[zero[0]]]}: vertex index 0 is invalid (OBJ indices start at 1; "
-                f"lines {format_indices(np.unique(lines[poly[zero]]))})"
+                f"{where}: line {lines[poly[zero[0]]]}: vertex index 0 is invalid (OBJ indices start at 1){more}"
             )
         res = idx - 1
         neg = idx < 0
@@ -290,31 +292,34 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None, line_word
         corners = np.flatnonzero(bad)
         bad_polys = np.unique(poly[corners])
         detail = "; ".join(
-            f"{line_word} {lines[poly[c]]}: index {idx[c]}" for c in corners[:5]
+            f"line {lines[poly[c]]} (face {first_tri[poly[c]]}): index {idx[c]}" for c in corners[:5]
         )
+        if len(corners) > 5:
+            detail += f" (and {len(corners) - 5} more)"
+        valid = f"1..{n}, or -1..-{n} counting back" if one_based else f"0..{n - 1}"
         raise MeshError(
-            f"{where}: face indices out of range, the file has {n} vertices "
-            f"({'1..' + str(n) + ' or -1..-' + str(n) if one_based else '0..' + str(n - 1)} are valid): "
-            f"{detail}" + (f" (and {len(corners) - 5} more)" if len(corners) > 5 else "")
-            + f"; {len(bad_polys)} faces on {line_word}s {format_indices(lines[bad_polys])}"
+            f"{where}: face indices out of range, the file has {_count(range(n), 'vertex', 'vertices')} "
+            f"(valid: {valid}): {detail}; {_count(bad_polys, 'face')} on "
+            f"line{'s' if len(bad_polys) > 1 else ''} {format_indices(lines[bad_polys])}"
         )
     if (sizes == 3).all():
         F = res.reshape(-1, 3)
         tri_poly = None
     else:
-        ntri = sizes - 2
         tri_poly = np.repeat(np.arange(len(sizes)), ntri)
-        j = np.arange(int(ntri.sum())) - np.repeat(np.cumsum(ntri) - ntri, ntri) + 1
+        j = np.arange(int(ntri.sum())) - first_tri[tri_poly] + 1
         o = (np.cumsum(sizes) - sizes)[tri_poly]
         F = np.stack([res[o], res[o + j], res[o + j + 1]], axis=1)
     rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
     if rep.any():
         rows = np.flatnonzero(rep)
         plines = lines[rows if tri_poly is None else tri_poly[rows]]
-        detail = "; ".join(f"{line_word} {L}: face {r} = {F[r].tolist()}" for r, L in zip(rows[:5], plines[:5]))
+        detail = "; ".join(f"line {L}: face {r} = {F[r].tolist()}" for r, L in zip(rows[:5], plines[:5]))
+        tail = (f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}"
+                if len(rows) > 1 else "")
         raise MeshError(
-            f"{where}: {len(rows)} face(s) repeat a vertex (no triangle; 0-based indices): {detail}"
-            + f"; faces {format_indices(rows)} on {line_word}s {format_indices(np.unique(plines))}"
+            f"{where}: {_count(rows, 'face repeats', 'faces repeat')} a vertex (no triangle; 0-based vertex "
+            f"indices): {detail}{tail}"
         )
     return np.ascontiguousarray(F, dtype=np.int64)
 
@@ -348,10 +353,10 @@ def _no_mesh_check(where, nv, nf):
 def _check_vertices(V, where, lines_of=None):
     if not np.isfinite(V).all():
         bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-        at = f" (lines {format_indices(lines_of[bad])})" if lines_of is not None else ""
+        at = f"; lines {format_indices(lines_of[bad])}" if lines_of is not None else ""
         raise MeshError(
-            f"{where}: {len(bad)} vertices have NaN or infinite coordinates: vertices {format_indices(bad)} "
-            f"(0-based){at}"
+            f"{where}: {_count(bad, 'vertex has', 'vertices have')} NaN or infinite coordinates: "
+            f"vertices {format_indices(bad)} (0-based{at})"
         )
     return as_vertices(V, where=where)
 
@@ -396,7 +401,7 @@ def _read_off(data, where):
     if len(vlines) < nv or len(flines) < nf:
         raise MeshError(
             f"{where}: the header (line {lineno}) announces {nv} vertices and {nf} faces, but the file ends "
-            f"after {len(vlines)} vertex lines and {len(flines)} face lines"
+            f"after {_count(vlines, 'vertex line')} and {_count(flines, 'face line')}"
         )
     _no_mesh_check(where, nv, nf)
     V = np.empty((nv, 3))
@@ -433,8 +438,11 @@ def _read_off(data, where):
 # PLY and STL through trimesh
 
 
-def _read_trimesh(path, where, ext):
+def _read_trimesh(path, where, ext, data):
     import trimesh
+
+    if ext == ".ply" and not data.lstrip().startswith(b"ply"):
+        raise MeshError(f"{where}: not a PLY file: it does not start with the line 'ply'")
 
     try:
         with warnings.catch_warnings():
@@ -520,7 +528,7 @@ def load_mesh(path, report=False):
     elif ext == ".off":
         V, F = _read_off(data, where)
     else:
-        V, F = _read_trimesh(p, where, ext)
+        V, F = _read_trimesh(p, where, ext, data)
     rep = check_mesh(V, F)
     if report:
         return V, F, rep

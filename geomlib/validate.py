@@ -113,7 +113,7 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
         rows = np.flatnonzero(rep)
         detail = ", ".join(f"face {r} = {F[r].tolist()}" for r in rows[:5])
         raise MeshError(
-            f"{_prefix(where)}{len(rows)} face(s) repeat a vertex (no triangle): {detail}; "
+            f"{_prefix(where)}{_count(rows, 'face repeats', 'faces repeat')} a vertex (no triangle): {detail}; "
             f"faces {format_indices(rows)}"
         )
     return F
@@ -137,7 +137,7 @@ def as_vertices(V, *, where=None):
         bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
         if len(bad):
             raise MeshError(
-                f"{_prefix(where)}{len(bad)} vertices have NaN or infinite coordinates: "
+                f"{_prefix(where)}{_count(bad, 'vertex has', 'vertices have')} NaN or infinite coordinates: "
                 f"vertices {format_indices(bad)}"
             )
     return V

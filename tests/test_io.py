@@ -250,31 +250,34 @@ def test_faces_but_no_vertices(tmp_path):
 def test_nan_and_inf_coordinates(tmp_path):
     text = "v 0 0 0\nv nan 0 0\nv 0 1 0\nv 0 0 inf\nf 1 2 3\nf 1 3 4\n"
     expect(write(tmp_path, "nan.obj", text),
-           r": 2 vertices have NaN or infinite coordinates: vertices 1, 3 \(0-based\) \(lines 2, 4\)$")
+           r": 2 vertices have NaN or infinite coordinates: vertices 1, 3 \(0-based; lines 2, 4\)$")
 
 
 def test_face_index_out_of_range(tmp_path):
     text = "# header\n" + SQUARE_V + "f 1 2 3\nf 1 3 5\nf 9 1 2\n"
     msg = expect(write(tmp_path, "range.obj", text), r": face indices out of range, the file has 4 vertices")
-    assert "(1..4 or -1..-4 are valid)" in msg
-    assert "line 7: index 5; line 8: index 9" in msg
+    assert "(valid: 1..4, or -1..-4 counting back)" in msg
+    assert "line 7 (face 1): index 5; line 8 (face 2): index 9" in msg
     assert msg.endswith("2 faces on lines 7, 8")
 
 
 def test_negative_index_out_of_range(tmp_path):
     text = "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"  # only 2 vertices above the face
-    expect(write(tmp_path, "neg.obj", text), r"out of range, the file has 3 vertices .*: line 3: index -3; 1 faces on lines 3$")
+    expect(write(tmp_path, "neg.obj", text), r"out of range, the file has 3 vertices .*: line 3 \(face 0\): index -3; 1 face on line 3$")
 
 
 def test_index_zero(tmp_path):
     expect(write(tmp_path, "zero.obj", SQUARE_V + "f 1 2 3\nf 0 1 2\n"),
-           r": line 6: vertex index 0 is invalid \(OBJ indices start at 1; lines 6\)$")
+           r": line 6: vertex index 0 is invalid \(OBJ indices start at 1\)$")
 
 
 def test_face_repeating_a_vertex(tmp_path):
-    msg = expect(write(tmp_path, "rep.obj", SQUARE_V + "f 1 2 3\nf 3 4 3\n"),
-                 r": 1 face\(s\) repeat a vertex \(no triangle; 0-based indices\): line 6: face 1 = \[2, 3, 2\]")
-    assert msg.endswith("faces 1 on lines 6")
+    expect(write(tmp_path, "rep.obj", SQUARE_V + "f 1 2 3\nf 3 4 3\n"),
+           r": 1 face repeats a vertex \(no triangle; 0-based vertex indices\): line 6: face 1 = \[2, 3, 2\]$")
+    # a pentagon listing a corner twice in a row (its fan has a degenerate triangle), and a bad triangle
+    msg = expect(write(tmp_path, "rep2.obj", SQUARE_V + "f 1 2 3 3 4\nf 4 4 1\n"),
+                 r": 2 faces repeat a vertex .*: line 5: face 1 = \[0, 2, 2\]; line 6: face 3 = \[3, 3, 0\]")
+    assert msg.endswith("faces 1, 3 on lines 5, 6")
 
 
 def test_malformed_vertex_line(tmp_path):
@@ -328,7 +331,7 @@ def test_off_bad_header(tmp_path):
 
 def test_off_truncated(tmp_path):
     expect(write(tmp_path, "t.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n"),
-           r": the header \(line 2\) announces 4 vertices and 2 faces, but the file ends after 4 vertex lines and 1 face lines$")
+           r": the header \(line 2\) announces 4 vertices and 2 faces, but the file ends after 4 vertex lines and 1 face line$")
 
 
 def test_off_malformed_lines(tmp_path):
@@ -340,14 +343,14 @@ def test_off_malformed_lines(tmp_path):
 
 def test_off_index_out_of_range(tmp_path):
     msg = expect(write(tmp_path, "r.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"),
-                 r": face indices out of range, the file has 3 vertices \(0..2 are valid\): line 7: index 3")
-    assert msg.endswith("1 faces on lines 7")
+                 r": face indices out of range, the file has 3 vertices \(valid: 0..2\): line 7 \(face 1\): index 3")
+    assert msg.endswith("1 face on line 7")
 
 
 def test_off_vertices_but_no_faces_and_nan(tmp_path):
     expect(write(tmp_path, "p.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), r": the file has 3 vertices but no faces")
     expect(write(tmp_path, "n.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
-           r": 1 vertices have NaN or infinite coordinates: vertices 1 \(0-based\) \(lines 4\)$")
+           r": 1 vertex has NaN or infinite coordinates: vertices 1 \(0-based; lines 4\)$")
 
 
 def test_off_binary_refused(tmp_path):
@@ -355,7 +358,8 @@ def test_off_binary_refused(tmp_path):
 
 
 def test_ply_and_stl_garbage(tmp_path):
-    expect(write(tmp_path, "g.ply", b"this is not a ply file\n"), r": cannot read as PLY: ")
+    expect(write(tmp_path, "g.ply", b"this is not a ply file\n"), r": not a PLY file: it does not start with the line 'ply'$")
+    expect(write(tmp_path, "h.ply", b"ply\nformat ascii 1.0\nelement vertex x\n"), r": cannot read as PLY: ")
     expect(write(tmp_path, "g.stl", b"solid x\nfacet what\n"), r": cannot read as STL: ")
 
 
@@ -365,7 +369,7 @@ def test_ply_out_of_range_and_nan(tmp_path):
     expect(write(tmp_path, "r.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"),
            r"face indices out of range \(valid: 0..2 for 3 vertices\): face 0 has index 5")
     expect(write(tmp_path, "n.ply", head + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
-           r"1 vertices have NaN or infinite coordinates: vertices 1 \(0-based\)$")
+           r"1 vertex has NaN or infinite coordinates: vertices 1 \(0-based\)$")
 
 
 def test_ply_vertices_but_no_faces(tmp_path):

@@ -249,7 +249,7 @@ def test_functions_validate_faces():
         valence(np.array([[0, 1, 2], [0, -2, 1]]))
     with pytest.raises(MeshError, match=r"valid: 0..2 for 3 vertices.*face 0 has index 3"):
         boundary_vertices(np.array([[0, 1, 3]]), n=3)
-    with pytest.raises(MeshError, match=r"repeat a vertex.*face 0 = \[1, 1, 2\]"):
+    with pytest.raises(MeshError, match=r"1 face repeats a vertex.*face 0 = \[1, 1, 2\]"):
         boundary_loops(np.array([[1, 1, 2]]))
 
 

@@ -96,7 +96,7 @@ def test_as_mesh_indices_out_of_range():
 def test_as_mesh_repeated_vertex_names_the_faces():
     V, F = tetrahedron()
     F = np.vstack([F, [[1, 1, 2], [3, 0, 3]]])
-    with pytest.raises(MeshError, match=r"2 face\(s\) repeat a vertex.*face 4 = \[1, 1, 2\], face 5 = \[3, 0, 3\]; faces 4, 5"):
+    with pytest.raises(MeshError, match=r"2 faces repeat a vertex.*face 4 = \[1, 1, 2\], face 5 = \[3, 0, 3\]; faces 4, 5"):
         as_mesh(V, F)
 
 
