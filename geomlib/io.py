@@ -30,7 +30,10 @@ OFF (own parser)
     indices (extra numbers after them ignored), polygons fan-triangulated as
     for OBJ. Binary OFF is not supported.
 PLY (read with trimesh, ``process=False, maintain_order=True``)
-    Vertex order and count as in the file; polygons are triangulated by trimesh.
+    Vertex order and count as in the file. Triangles keep the file's order;
+    larger polygons are triangulated by trimesh, which lists them after the
+    file's triangles when a file mixes both (quads split as (0, 1, 2),
+    (2, 3, 0)). Errors name the face rows of the returned F, no line numbers.
 STL (read with trimesh, ``process=False``)
     STL has no shared vertices: each facet stores its own three corners. The
     corners are kept as they are, three vertices per facet in file order
@@ -494,7 +497,9 @@ def load_mesh(path, report=False):
     V : (n, 3) float64
         Vertex positions in the file's units.
     F : (m, 3) int64
-        Triangles, 0-based, in the file's order and orientation.
+        Triangles, 0-based, in the file's order and orientation (polygons
+        fan-triangulated in place; for PLY files mixing triangles and larger
+        polygons, see the module notes).
     report : MeshReport
         Only when ``report=True``.
 

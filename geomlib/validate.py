@@ -433,7 +433,7 @@ def check_mesh(V, F):
             "curvature and smoothing work per component")
     if len(unref):
         problems.append(
-            f"{_count(unref, 'unreferenced vertex', 'unreferenced vertices')} ({format_indices(unref)}): they have zero area and no neighbours, "
+            f"{_count(unref, 'unreferenced vertex', 'unreferenced vertices')} ({format_indices(unref)}): no area and no neighbours, "
             "so their Laplacian rows are zero and M is singular there; they are kept so that indices match the file")
     if len(dups):
         problems.append(
