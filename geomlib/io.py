@@ -203,13 +203,11 @@ def _obj_slow(data, where):
             raw = pending + b" " + raw
             lineno = pending_line
             pending = b""
-        stripped = raw.rstrip()
-        if stripped.endswith(b"\\"):
+        hash_pos = raw.find(b"#")  # a comment runs to the end of the line
+        stripped = (raw[:hash_pos] if hash_pos >= 0 else raw).rstrip()
+        if stripped.endswith(b"\\"):  # continued on the next line
             pending, pending_line = stripped[:-1], lineno
             continue
-        hash_pos = stripped.find(b"#")
-        if hash_pos >= 0:
-            stripped = stripped[:hash_pos]
         words = stripped.split()
         if not words:
             continue

@@ -89,6 +89,12 @@ def test_obj_inline_comments(tmp_path):
     assert np.array_equal(F, [[0, 1, 2], [0, 2, 3]])
 
 
+def test_obj_backslash_in_a_comment_is_not_a_continuation(tmp_path):
+    text = "# made in C:\\meshes\\\n" + SQUARE_V + "f 1 2 3\nf 1 3 4\n"
+    V, F = load_quiet(write(tmp_path, "bs.obj", text))
+    assert len(V) == 4 and np.array_equal(F, [[0, 1, 2], [0, 2, 3]])
+
+
 def test_obj_without_final_newline_and_tabs(tmp_path):
     V, F = load_quiet(write(tmp_path, "t.obj", "v\t0 0 0\nv 1\t0 0\nv 0 1 0\nf\t1 2 3"))
     assert len(V) == 3 and np.array_equal(F, [[0, 1, 2]])
