@@ -22,11 +22,16 @@ Resolution: ``subdivisions`` (icosphere) halves the edge length per step; the
 grid sizes ``n`` of the grid-based surfaces can be doubled (``n`` counts
 intervals, so ``2 n`` halves every edge). This is what a convergence study needs.
 
-Where the truth comes from: the sphere and the plane are trivial (``1/r``,
-``0``). For the ellipsoid, torus and saddle the curvature is written here in
-closed form (implicit-surface formulas for the ellipsoid, the parametrisation
-for the torus, the Monge-patch formulas for the height field); tests check them
-against independent derivations.
+Where the truth comes from: one source, :mod:`geomlib.symbolic`. For the
+ellipsoid, torus and saddle, ``N``, ``H``, ``K``, ``k1``, ``k2`` are the sympy
+expressions of ``geomlib.symbolic.ellipsoid(a, b, c)``, ``torus(R, r)`` and
+``monge(h, x, y)``, compiled with their ``lambdify`` and evaluated at each
+vertex's parameters ``uv`` (the ellipsoid's expressions stay finite at the
+poles). The sphere and the plane are the trivial cases ``H = 1/r`` and
+``H = K = 0``. The truth is computed on first access to ``N``, ``H``, ...:
+compiling a surface family takes a few seconds once per process, and a mesh
+that is only written to a file does not pay for it. The tests check the
+values against closed forms derived independently.
 
 Functions: :func:`plane`, :func:`saddle`, :func:`sphere` (icosphere),
 :func:`uv_sphere`, :func:`ellipsoid` (mapped icosphere), :func:`uv_ellipsoid`,
@@ -36,9 +41,10 @@ instance ``meshes/ellipsoid.obj``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Mapping
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -88,6 +94,9 @@ class AnalyticMesh:
         Exact mean (1/length) and Gaussian (1/length^2) curvature.
     k1, k2 : (n,) float64
         Exact principal curvatures, ``k1 >= k2``.
+
+    ``N``, ``H``, ``K``, ``k1``, ``k2`` are evaluated (from geomlib.symbolic)
+    on first access and then kept.
     uv : (n, 2) float64 or None
         Parameter values of each vertex (see the surface's function for the
         parametrisation), None where the surface has no global parametrisation.
@@ -104,15 +113,44 @@ class AnalyticMesh:
     params: Mapping[str, object]
     V: np.ndarray
     F: np.ndarray
-    N: np.ndarray
-    H: np.ndarray
-    K: np.ndarray
-    k1: np.ndarray
-    k2: np.ndarray
     uv: np.ndarray | None
     closed: bool
     area: float | None = None
     volume: float | None = None
+    truth: Callable[[], tuple] | None = field(default=None, repr=False, compare=False)
+
+    @functools.cached_property
+    def _values(self):
+        n = self.V.shape[0]
+        N, H, K, k1, k2 = self.truth()
+        out = {}
+        for key, val, shape in (("N", N, (n, 3)), ("H", H, (n,)), ("K", K, (n,)), ("k1", k1, (n,)), ("k2", k2, (n,))):
+            a = np.ascontiguousarray(np.broadcast_to(np.asarray(val, dtype=np.float64), shape))
+            if not np.isfinite(a).all():  # a chart singularity would show up here, never silently
+                bad = np.flatnonzero(~np.isfinite(a.reshape(n, -1)).all(axis=1))
+                raise MeshError(f"{self.name}: exact {key} is not finite at vertices {format_indices(bad)}")
+            out[key] = a
+        return out
+
+    @property
+    def N(self) -> np.ndarray:
+        return self._values["N"]
+
+    @property
+    def H(self) -> np.ndarray:
+        return self._values["H"]
+
+    @property
+    def K(self) -> np.ndarray:
+        return self._values["K"]
+
+    @property
+    def k1(self) -> np.ndarray:
+        return self._values["k1"]
+
+    @property
+    def k2(self) -> np.ndarray:
+        return self._values["k2"]
 
     @property
     def n_vertices(self) -> int:
@@ -188,12 +226,13 @@ def _face_normals(V, F):
     return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
 
 
-def _check_faces(V, F, N, what):
-    """Raise MeshError on zero-area faces or faces that disagree with N.
+def _check_faces(V, F, D, what):
+    """Raise MeshError on zero-area faces or faces that disagree with D.
 
-    A face is inverted when its normal points against the mean of the exact
-    normals of its three vertices; this happens only when the jitter folds
-    the tessellation over, and is reported rather than repaired.
+    ``D`` (n, 3) is a direction on the outer (upper) side at each vertex. A
+    face is inverted when its normal points against the sum of ``D`` over its
+    three vertices; this happens only when the jitter folds the tessellation
+    over, and is reported rather than repaired.
     """
     FN = _face_normals(V, F)
     A2 = np.linalg.norm(FN, axis=1)
@@ -201,16 +240,10 @@ def _check_faces(V, F, N, what):
     bad = np.flatnonzero(A2 <= 1e-12 * scale)
     if bad.size:
         raise MeshError(f"{what}: zero-area faces {format_indices(bad)}")
-    s = np.einsum("ij,ij->i", FN, N[F].sum(axis=1))
+    s = np.einsum("ij,ij->i", FN, D[F].sum(axis=1))
     bad = np.flatnonzero(s <= 0)
     if bad.size:
         raise MeshError(f"{what}: inverted faces {format_indices(bad)} (jitter too large for this resolution)")
-
-
-def _principal(H, K):
-    """k1 >= k2 from H and K; H^2 - K < 0 only by rounding at umbilics."""
-    d = np.sqrt(np.maximum(H * H - K, 0.0))
-    return H + d, H - d
 
 
 def _grid_faces(nu, nv, periodic_u=False, periodic_v=False, diagonals="right"):
@@ -261,30 +294,85 @@ def _grid_jitter(rng, shape, jitter, fixed_u=None, fixed_v=None):
     return du, dv
 
 
-def _make(name, params, V, F, N, H, K, uv, closed, area=None, volume=None):
-    V = np.ascontiguousarray(V, dtype=np.float64)
-    F = np.ascontiguousarray(F, dtype=np.int64)
-    N = np.ascontiguousarray(N, dtype=np.float64)
-    H = np.ascontiguousarray(H, dtype=np.float64)
-    K = np.ascontiguousarray(K, dtype=np.float64)
-    k1, k2 = _principal(H, K)
+def _make(name, params, V, F, uv, closed, truth, area=None, volume=None):
     if uv is not None:
         uv = np.ascontiguousarray(uv, dtype=np.float64)
     return AnalyticMesh(
         name=name,
         params=MappingProxyType(dict(params)),
-        V=V,
-        F=F,
-        N=N,
-        H=H,
-        K=K,
-        k1=k1,
-        k2=k2,
+        V=np.ascontiguousarray(V, dtype=np.float64),
+        F=np.ascontiguousarray(F, dtype=np.int64),
         uv=uv,
         closed=closed,
         area=None if area is None else float(area),
         volume=None if volume is None else float(volume),
+        truth=truth,
     )
+
+
+def _constant_truth(n, normal, H, K):
+    """Truth of a plane (normal fixed, H = K = 0) or a sphere (normal given, H = 1/r)."""
+
+    def truth():
+        N = np.broadcast_to(normal, (n, 3))
+        return N, np.full(n, H), np.full(n, K), np.full(n, H), np.full(n, H)
+
+    return truth
+
+
+# ----------------------------------------------------------------------------
+# the one source of exact curvature: geomlib.symbolic
+# ----------------------------------------------------------------------------
+
+
+def _exact_number(x):
+    """A float as the exact rational of its shortest decimal (0.7 -> 7/10)."""
+    import sympy as sp
+
+    return sp.Rational(repr(float(x)))
+
+
+@functools.lru_cache(maxsize=32)
+def _symbolic_surface(kind, params):
+    """The geomlib.symbolic surface for ("ellipsoid", (a, b, c)), ("torus", (R, r))
+    or ("saddle", (A, B)), made once per parameter set and process."""
+    import sympy as sp
+
+    from . import symbolic
+
+    if kind == "ellipsoid":
+        return symbolic.ellipsoid(*params)
+    if kind == "torus":
+        return symbolic.torus(*params)
+    if kind == "saddle":
+        A, B = (_exact_number(t) for t in params)
+        x, y = sp.symbols("x y", real=True)
+        # a polynomial: sympy simplifies its curvature quickly and reliably
+        h = A * sp.Rational(27, 4) * x * (1 - x**2) * y * (1 - y**2) + B * (x**3 - 3 * x * y**2)
+        return symbolic.monge(h, x, y, name="saddle")
+    raise MeshError(f"no symbolic surface {kind!r}")  # pragma: no cover
+
+
+def _symbolic_truth(kind, params, uv):
+    """Truth evaluated lazily: unit normal, H, K from geomlib.symbolic at the
+    parameters uv, and k1, k2 = H +- sqrt(H^2 - K) from them.
+
+    (H^2 - K >= 0 holds exactly; a negative value is rounding at an umbilic
+    point and is clamped to 0. Deriving k1, k2 from H and K spares compiling
+    a third family of expressions; the tests compare them with
+    ``lambdify("principal_curvatures")``.)
+    """
+
+    def truth():
+        s = _symbolic_surface(kind, tuple(float(t) for t in params))
+        u, v = uv[:, 0], uv[:, 1]
+        N = s.lambdify("unit_normal")(u, v)
+        H = s.lambdify("mean_curvature")(u, v)
+        K = s.lambdify("gaussian_curvature")(u, v)
+        d = np.sqrt(np.maximum(H * H - K, 0.0))
+        return N, H, K, H + d, H - d
+
+    return truth
 
 
 # ----------------------------------------------------------------------------
@@ -344,60 +432,37 @@ def plane(n=20, size=2.0, jitter=0.0, seed=0, diagonals="right"):
     x, y = _square_grid(n, size, jitter, seed)
     V = np.stack([x, y, np.zeros_like(x)], axis=1)
     F = _grid_faces(n + 1, n + 1, diagonals=diagonals)
-    N = np.tile([0.0, 0.0, 1.0], (V.shape[0], 1))
-    zero = np.zeros(V.shape[0])
-    _check_faces(V, F, N, "plane")
+    up = np.array([0.0, 0.0, 1.0])
+    _check_faces(V, F, np.broadcast_to(up, V.shape), "plane")
     params = dict(n=n, size=size, jitter=jitter, seed=seed, diagonals=diagonals)
-    return _make("plane", params, V, F, N, zero, zero, np.stack([x, y], 1), False, area=size * size)
+    truth = _constant_truth(V.shape[0], up, 0.0, 0.0)
+    return _make("plane", params, V, F, np.stack([x, y], 1), False, truth, area=size * size)
 
 
 def saddle_height(x, y, amplitude=0.2, monkey=0.1):
-    """Height of the saddle surface: ``z = A sin(pi x) sin(pi y) + B (x^3 - 3 x y^2)``.
+    """Height of the saddle surface: ``z = A (27/4) x (1 - x^2) y (1 - y^2) + B (x^3 - 3 x y^2)``.
 
-    ``A = amplitude``, ``B = monkey``; on the square [-1, 1]^2 (``size = 2``)
-    it has two bumps, two dips and saddles in between, plus the monkey-saddle
-    term that breaks the symmetry. Lengths in the same units as x, y.
+    ``A = amplitude`` (the height of the bumps: ``x (1 - x^2)`` peaks at
+    ``2 / (3 sqrt 3)``, hence the factor 27/4), ``B = monkey``. On the square
+    [-1, 1]^2 (``size = 2``) the first term has two bumps, two dips, a saddle
+    at the origin and four more on the boundary, like
+    ``sin(pi x) sin(pi y)``; the monkey-saddle term breaks the symmetry.
+    A polynomial, so that its exact curvature is a rational expression.
+    x, y, z in the same length units.
     """
     x = np.asarray(x, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
-    return amplitude * np.sin(np.pi * x) * np.sin(np.pi * y) + monkey * (x**3 - 3.0 * x * y**2)
-
-
-def _saddle_derivatives(x, y, A, B):
-    """First and second partial derivatives of the saddle height."""
-    p = np.pi
-    sx, cx, sy, cy = np.sin(p * x), np.cos(p * x), np.sin(p * y), np.cos(p * y)
-    hx = A * p * cx * sy + B * (3 * x**2 - 3 * y**2)
-    hy = A * p * sx * cy - 6 * B * x * y
-    hxx = -A * p * p * sx * sy + 6 * B * x
-    hxy = A * p * p * cx * cy - 6 * B * y
-    hyy = -A * p * p * sx * sy - 6 * B * x
-    return hx, hy, hxx, hxy, hyy
-
-
-def _monge_truth(hx, hy, hxx, hxy, hyy):
-    """Upward normal, H, K of a height field z = h(x, y) (Monge patch).
-
-    With the upward normal n = (-h_x, -h_y, 1) / W, W = sqrt(1 + h_x^2 + h_y^2):
-    K = (h_xx h_yy - h_xy^2) / W^4 and, in the workbook's sign (H > 0 where the
-    surface bends away from n, as a sphere from its outward normal),
-    H = -((1 + h_y^2) h_xx - 2 h_x h_y h_xy + (1 + h_x^2) h_yy) / (2 W^3).
-    """
-    W2 = 1.0 + hx * hx + hy * hy
-    W = np.sqrt(W2)
-    N = np.stack([-hx, -hy, np.ones_like(hx)], axis=1) / W[:, None]
-    K = (hxx * hyy - hxy * hxy) / (W2 * W2)
-    H = -((1.0 + hy * hy) * hxx - 2.0 * hx * hy * hxy + (1.0 + hx * hx) * hyy) / (2.0 * W2 * W)
-    return N, H, K
+    return amplitude * 6.75 * x * (1.0 - x * x) * y * (1.0 - y * y) + monkey * (x**3 - 3.0 * x * y**2)
 
 
 def saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.0, seed=0, diagonals="right"):
-    """Open height field with saddles: ``z = A sin(pi x) sin(pi y) + B (x^3 - 3 x y^2)``.
+    """Open height field with saddles: ``z = A (27/4) x (1 - x^2) y (1 - y^2) + B (x^3 - 3 x y^2)``.
 
     Convention: triangles counter-clockwise seen from +z, ``N`` the upward
     unit normal, ``H > 0`` where the surface bends down (away from ``N``).
+    Exact truth: ``geomlib.symbolic.monge(h, x, y)`` at the vertices' (x, y).
     Defined over the square [-size/2, size/2]^2 (x, y in length units; the
-    height uses x, y directly, so ``size = 2`` shows one full period).
+    height uses x, y directly and is meant for ``size <= 2``).
 
     Parameters
     ----------
@@ -429,10 +494,11 @@ def saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.0, seed=0, diagon
     x, y = _square_grid(n, size, jitter, seed)
     V = np.stack([x, y, saddle_height(x, y, A, B)], axis=1)
     F = _grid_faces(n + 1, n + 1, diagonals=diagonals)
-    N, H, K = _monge_truth(*_saddle_derivatives(x, y, A, B))
-    _check_faces(V, F, N, "saddle")
+    # upward side: +z (the tessellation must not fold over in the (x, y) plane)
+    _check_faces(V, F, np.broadcast_to([0.0, 0.0, 1.0], V.shape), "saddle")
     params = dict(n=n, size=size, amplitude=A, monkey=B, jitter=jitter, seed=seed, diagonals=diagonals)
-    return _make("saddle", params, V, F, N, H, K, np.stack([x, y], 1), False)
+    uv = np.stack([x, y], 1)
+    return _make("saddle", params, V, F, uv, False, _symbolic_truth("saddle", (A, B), uv))
 
 
 # ----------------------------------------------------------------------------
@@ -543,23 +609,6 @@ def _ellipsoid_uv(X, a, b, c):
     return np.stack([u, v], axis=1)
 
 
-def _ellipsoid_truth(X, a, b, c):
-    """Outward normal, H, K of the ellipsoid x^2/a^2 + y^2/b^2 + z^2/c^2 = 1.
-
-    With g = (x/a^2, y/b^2, z/c^2) (half the gradient of the implicit function):
-    N = g / |g|, K = 1 / (a^2 b^2 c^2 |g|^4),
-    H = (a^2 + b^2 + c^2 - |x|^2) / (2 a^2 b^2 c^2 |g|^3)  (H = 1/r on a sphere).
-    Valid everywhere, the poles included.
-    """
-    g = X / np.array([a * a, b * b, c * c])
-    G = np.linalg.norm(g, axis=1)
-    N = g / G[:, None]
-    abc2 = (a * b * c) ** 2
-    K = 1.0 / (abc2 * G**4)
-    H = (a * a + b * b + c * c - np.einsum("ij,ij->i", X, X)) / (2.0 * abc2 * G**3)
-    return N, H, K
-
-
 def _ellipsoid_area(a, b, c):
     """Exact area of the ellipsoid (Legendre's form with elliptic integrals)."""
     from scipy.special import ellipeinc, ellipkinc
@@ -603,12 +652,12 @@ def sphere(r=1.0, subdivisions=3, jitter=0.0, seed=0):
     if jitter > 0:
         P = _sphere_jitter(P, F, jitter, seed)
     V = r * P
-    n = V.shape[0]
     _check_faces(V, F, P, "sphere")
     params = dict(r=r, subdivisions=subdivisions, jitter=jitter, seed=seed)
+    truth = _constant_truth(V.shape[0], P, 1.0 / r, 1.0 / r**2)
     return _make(
-        "sphere", params, V, F, P, np.full(n, 1.0 / r), np.full(n, 1.0 / r**2),
-        _ellipsoid_uv(V, r, r, r), True, area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3,
+        "sphere", params, V, F, _ellipsoid_uv(V, r, r, r), True, truth,
+        area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3,
     )
 
 
@@ -644,11 +693,11 @@ def ellipsoid(a=1.0, b=0.7, c=0.5, subdivisions=3, jitter=0.0, seed=0):
     if jitter > 0:
         P = _sphere_jitter(P, F, jitter, seed)
     V = P * np.array([a, b, c])
-    N, H, K = _ellipsoid_truth(V, a, b, c)
-    _check_faces(V, F, N, "ellipsoid")
+    _check_faces(V, F, V / np.array([a * a, b * b, c * c]), "ellipsoid")  # gradient side = outside
     params = dict(a=a, b=b, c=c, subdivisions=subdivisions, jitter=jitter, seed=seed)
+    uv = _ellipsoid_uv(V, a, b, c)
     return _make(
-        "ellipsoid", params, V, F, N, H, K, _ellipsoid_uv(V, a, b, c), True,
+        "ellipsoid", params, V, F, uv, True, _symbolic_truth("ellipsoid", (a, b, c), uv),
         area=_ellipsoid_area(a, b, c), volume=4.0 / 3.0 * np.pi * a * b * c,
     )
 
@@ -702,11 +751,10 @@ def uv_ellipsoid(a=1.0, b=0.7, c=0.5, n=16, jitter=0.0, seed=0):
     n = _count("n", n, 2)
     jitter = _jitter(jitter)
     V, F, uv = _uv_ellipsoid_mesh(a, b, c, n, jitter, seed)
-    N, H, K = _ellipsoid_truth(V, a, b, c)
-    _check_faces(V, F, N, "uv_ellipsoid")
+    _check_faces(V, F, V / np.array([a * a, b * b, c * c]), "uv_ellipsoid")
     params = dict(a=a, b=b, c=c, n=n, jitter=jitter, seed=seed)
     return _make(
-        "ellipsoid", params, V, F, N, H, K, uv, True,
+        "ellipsoid", params, V, F, uv, True, _symbolic_truth("ellipsoid", (a, b, c), uv),
         area=_ellipsoid_area(a, b, c), volume=4.0 / 3.0 * np.pi * a * b * c,
     )
 
@@ -722,11 +770,10 @@ def uv_sphere(r=1.0, n=16, jitter=0.0, seed=0):
     V, F, uv = _uv_ellipsoid_mesh(r, r, r, n, jitter, seed)
     N = V / r
     _check_faces(V, F, N, "uv_sphere")
-    m = V.shape[0]
     params = dict(r=r, n=n, jitter=jitter, seed=seed)
+    truth = _constant_truth(V.shape[0], N, 1.0 / r, 1.0 / r**2)
     return _make(
-        "sphere", params, V, F, N, np.full(m, 1.0 / r), np.full(m, 1.0 / r**2), uv, True,
-        area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3,
+        "sphere", params, V, F, uv, True, truth, area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3,
     )
 
 
@@ -738,21 +785,6 @@ def uv_sphere(r=1.0, n=16, jitter=0.0, seed=0):
 def _torus_point(u, v, R, r):
     w = R + r * np.cos(v)
     return np.stack([w * np.cos(u), w * np.sin(u), r * np.sin(v)], axis=1)
-
-
-def _torus_truth(u, v, R, r):
-    """Outward normal, H, K of the torus
-    p(u, v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v).
-
-    N = (cos v cos u, cos v sin u, sin v); principal curvatures 1/r (meridian)
-    and cos v / (R + r cos v) (parallel), so
-    K = cos v / (r (R + r cos v)), H = (R + 2 r cos v) / (2 r (R + r cos v)).
-    """
-    N = np.stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)], axis=1)
-    w = R + r * np.cos(v)
-    K = np.cos(v) / (r * w)
-    H = (R + 2.0 * r * np.cos(v)) / (2.0 * r * w)
-    return N, H, K
 
 
 def torus(R=1.0, r=0.4, n=64, m=None, jitter=0.0, seed=0):
@@ -798,11 +830,12 @@ def torus(R=1.0, r=0.4, n=64, m=None, jitter=0.0, seed=0):
         v = v + dv * ov
     V = _torus_point(u, v, R, r)
     F = _grid_faces(n, m, periodic_u=True, periodic_v=True)
-    N, H, K = _torus_truth(u, v, R, r)
-    _check_faces(V, F, N, "torus")
+    # outside: away from the tube's centre circle
+    _check_faces(V, F, V - _torus_point(u, np.full_like(v, np.pi / 2), R, 0.0), "torus")
     params = dict(R=R, r=r, n=n, m=m, jitter=jitter, seed=seed)
+    uv = np.stack([u, v], 1)
     return _make(
-        "torus", params, V, F, N, H, K, np.stack([u, v], 1), True,
+        "torus", params, V, F, uv, True, _symbolic_truth("torus", (R, r), uv),
         area=4.0 * np.pi**2 * R * r, volume=2.0 * np.pi**2 * R * r * r,
     )
 
@@ -862,16 +895,15 @@ def attach_truth(name, V, F, **params):
     if name == "plane":
         dist = np.abs(V[:, 2])
         scale = 1.0
-        N = np.tile([0.0, 0.0, 1.0], (n, 1))
-        H = K = np.zeros(n)
         uv = V[:, :2].copy()
+        truth = _constant_truth(n, np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
     elif name == "saddle":
         A, B = _finite("amplitude", p["amplitude"]), _finite("monkey", p["monkey"])
         x, y = V[:, 0], V[:, 1]
         dist = np.abs(V[:, 2] - saddle_height(x, y, A, B))
         scale = 1.0
-        N, H, K = _monge_truth(*_saddle_derivatives(x, y, A, B))
         uv = V[:, :2].copy()
+        truth = _symbolic_truth("saddle", (A, B), uv)
     elif name in ("sphere", "ellipsoid"):
         if name == "sphere":
             a = b = c = _positive("r", p["r"])
@@ -879,25 +911,30 @@ def attach_truth(name, V, F, **params):
             a, b, c = _positive("a", p["a"]), _positive("b", p["b"]), _positive("c", p["c"])
         S = V / np.array([a, b, c])
         rho = np.linalg.norm(S, axis=1)
-        dist = np.abs(rho - 1.0)
-        scale = 1.0
         if np.any(rho == 0):
             raise MeshError(f"vertices {format_indices(np.flatnonzero(rho == 0))} are at the centre")
-        X = S / rho[:, None] * np.array([a, b, c])
-        N, H, K = _ellipsoid_truth(X, a, b, c)
+        dist = np.abs(rho - 1.0)  # relative: the scaled points should be unit vectors
+        scale = 1.0
+        X = S / rho[:, None] * np.array([a, b, c])  # radial projection in the scaled space
         uv = _ellipsoid_uv(X, a, b, c)
+        if name == "sphere":
+            truth = _constant_truth(n, X / a, 1.0 / a, 1.0 / a**2)
+        else:
+            truth = _symbolic_truth("ellipsoid", (a, b, c), uv)
         area, volume = _ellipsoid_area(a, b, c), 4.0 / 3.0 * np.pi * a * b * c
     else:
         R, r = _positive("R", p["R"]), _positive("r", p["r"])
+        if r >= R:
+            raise MeshError(f"torus needs r < R (a ring torus), got R={R!r}, r={r!r}")
         u = np.arctan2(V[:, 1], V[:, 0])
         w = np.hypot(V[:, 0], V[:, 1]) - R
         v = np.arctan2(V[:, 2], w)
         dist = np.abs(np.hypot(w, V[:, 2]) - r)
         scale = r
-        N, H, K = _torus_truth(u, v, R, r)
         uv = np.stack([u, v], 1)
+        truth = _symbolic_truth("torus", (R, r), uv)
         area, volume = 4.0 * np.pi**2 * R * r, 2.0 * np.pi**2 * R * r * r
     far = np.flatnonzero(dist > 1e-6 * scale)
     if far.size:
         raise MeshError(f"vertices {format_indices(far)} are not on the {name} with {p} (off by up to {dist.max():.3g})")
-    return _make(name, p, V, F, N, H, K, uv, closed, area=area, volume=volume)
+    return _make(name, p, V, F, uv, closed, truth, area=area, volume=volume)

@@ -97,7 +97,7 @@ def implicit_residual(m):
     if m.name == "plane":
         return V[:, 2]
     x, y = V[:, 0], V[:, 1]
-    return V[:, 2] - (p["amplitude"] * np.sin(np.pi * x) * np.sin(np.pi * y) + p["monkey"] * (x**3 - 3 * x * y * y))
+    return V[:, 2] - (p["amplitude"] * 6.75 * x * (1 - x * x) * y * (1 - y * y) + p["monkey"] * (x**3 - 3 * x * y * y))
 
 
 @pytest.fixture(params=[0.0, 0.3], ids=["regular", "jittered"])
@@ -260,7 +260,7 @@ def test_saddle_truth(jitter):
     A, B = 0.2, 0.1
     m = S.saddle(n=24, amplitude=A, monkey=B, jitter=jitter, seed=6)
     x, y = m.uv.T
-    h = lambda x, y: np.stack([x, y, A * np.sin(np.pi * x) * np.sin(np.pi * y) + B * (x**3 - 3 * x * y * y)], 1)  # noqa: E731
+    h = lambda x, y: np.stack([x, y, A * 6.75 * x * (1 - x * x) * y * (1 - y * y) + B * (x**3 - 3 * x * y * y)], 1)  # noqa: E731
     up = lambda x, y: np.tile([0.0, 0.0, 1.0], (x.size, 1))  # noqa: E731
     n, H, K = fundamental_truth(h, x, y, up)
     np.testing.assert_allclose(m.H, H, atol=2e-6)
@@ -274,12 +274,46 @@ def test_saddle_truth(jitter):
         assert np.hypot(x[o], y[o]) == 0 and abs(m.H[o]) < 1e-15
 
 
-def test_saddle_sign_on_a_bump():
-    # z = A sin(pi x) sin(pi y) peaks at (1/2, 1/2): it bends down, away from the upward normal
-    m = S.saddle(n=20, size=2.0, amplitude=0.2, monkey=0.0)
-    top = np.argmin(np.hypot(m.V[:, 0] - 0.5, m.V[:, 1] - 0.5))
-    assert m.H[top] > 0 and m.K[top] > 0
-    np.testing.assert_allclose(m.H[top], 0.2 * np.pi**2, rtol=1e-12)  # h_xx = h_yy = -A pi^2, h_x = h_y = 0
+def test_saddle_closed_form_at_the_origin_and_sign_on_a_bump():
+    # at the origin h_x = h_y = h_xx = h_yy = 0 and h_xy = (27/4) A: H = 0, K = -h_xy^2
+    A = 0.2
+    m = S.saddle(n=20, amplitude=A, monkey=0.1)
+    o = np.flatnonzero((m.V[:, 0] == 0) & (m.V[:, 1] == 0))[0]
+    assert abs(m.H[o]) < 1e-15
+    np.testing.assert_allclose(m.K[o], -(6.75 * A) ** 2, rtol=1e-14)
+    np.testing.assert_allclose([m.k1[o], m.k2[o]], [6.75 * A, -6.75 * A], rtol=1e-14)
+    np.testing.assert_allclose(m.N[o], [0, 0, 1], atol=1e-15)
+    # the highest vertex sits on a bump that bends down, away from the upward normal
+    top = np.argmax(m.V[:, 2])
+    assert 0 < abs(m.V[top, 0]) < 1 and 0 < abs(m.V[top, 1]) < 1
+    assert m.H[top] > 0 and m.K[top] > 0 and m.k2[top] > 0
+
+
+def monge_closed_form(hx, hy, hxx, hxy, hyy):
+    """Upward normal, H (workbook sign), K of z = h(x, y) from its derivatives."""
+    W2 = 1 + hx * hx + hy * hy
+    N = np.stack([-hx, -hy, np.ones_like(hx)], 1) / np.sqrt(W2)[:, None]
+    K = (hxx * hyy - hxy * hxy) / W2**2
+    H = -((1 + hy * hy) * hxx - 2 * hx * hy * hxy + (1 + hx * hx) * hyy) / (2 * W2**1.5)
+    return N, H, K
+
+
+def test_saddle_truth_against_monge_closed_form():
+    A, B = 0.2, 0.1
+    m = S.saddle(n=16, amplitude=A, monkey=B, jitter=0.3, seed=2)
+    x, y = m.uv.T
+    a = 6.75 * A
+    px, dpx, ddpx = x * (1 - x * x), 1 - 3 * x * x, -6 * x
+    py, dpy, ddpy = y * (1 - y * y), 1 - 3 * y * y, -6 * y
+    hx = a * dpx * py + B * (3 * x * x - 3 * y * y)
+    hy = a * px * dpy - 6 * B * x * y
+    hxx = a * ddpx * py + 6 * B * x
+    hxy = a * dpx * dpy - 6 * B * y
+    hyy = a * px * ddpy - 6 * B * x
+    N, H, K = monge_closed_form(hx, hy, hxx, hxy, hyy)
+    np.testing.assert_allclose(m.N, N, atol=1e-14)
+    np.testing.assert_allclose(m.H, H, atol=1e-13)
+    np.testing.assert_allclose(m.K, K, atol=1e-13)
 
 
 def test_plane_truth():
@@ -473,3 +507,23 @@ def test_analytic_mesh_is_frozen():
         m.V = None
     assert "sphere" in repr(m) and "42 vertices" in repr(m)
     assert m.n_vertices == 42 and m.n_faces == 80
+
+
+def test_principal_curvatures_agree_with_symbolic_principal_curvatures():
+    from geomlib import symbolic
+
+    m = S.ellipsoid(1.0, 0.7, 0.5, subdivisions=2, jitter=0.2, seed=0)
+    k1, k2 = symbolic.ellipsoid(1.0, 0.7, 0.5).lambdify("principal_curvatures")(*m.uv.T)
+    np.testing.assert_allclose(m.k1, k1, atol=1e-7)
+    np.testing.assert_allclose(m.k2, k2, atol=1e-7)
+    t = S.torus(1.0, 0.4, n=16)
+    k1, k2 = symbolic.torus(1.0, 0.4).lambdify("principal_curvatures")(*t.uv.T)
+    np.testing.assert_allclose(t.k1, k1, atol=1e-7)
+    np.testing.assert_allclose(t.k2, k2, atol=1e-7)
+
+
+def test_truth_is_computed_on_first_access_and_kept():
+    m = S.torus(1.0, 0.4, n=8)
+    assert "_values" not in m.__dict__
+    H = m.H
+    assert "_values" in m.__dict__ and m.H is H
