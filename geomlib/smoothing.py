@@ -624,6 +624,22 @@ class ImplicitSmoother:
         self._lu[step] = lu  # most recently used last
         return lu
 
+    def prepare(self, steps, iterations=0, keep_volume=False):
+        """Factorise for every step value in ``steps`` now (e.g. all positions of a
+        slider), and with ``iterations > 0`` also compute and keep that many
+        iterates for each, so that a slider callback only looks them up (or
+        solves for iterations beyond them). Grows both caches to hold them all."""
+        steps = [_check_step(s) for s in steps]
+        iterations = _check_iterations(iterations)
+        self.cache_size = max(self.cache_size, len(steps))
+        if iterations:
+            self.history_size = max(self.history_size, len(steps))
+        for s in steps:
+            self.factor(s)
+            if iterations:
+                self.smooth(s, iterations, keep_volume=keep_volume, progress=False)
+        return self
+
     def step_once(self, P, step, lu=None):
         """One implicit step from positions P (boundary rows taken from self.V)."""
         lu = self.factor(step) if lu is None else lu

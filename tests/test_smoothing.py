@@ -426,3 +426,14 @@ def test_progress_bar_appears_for_long_runs(monkeypatch, capsys):
     monkeypatch.setattr(smoothing, "PROGRESS_SECONDS", 1e9)  # no run does
     explicit_smoothing(V, F, 1e-4, 3)
     assert capsys.readouterr().err == ""
+
+
+def test_prepare_factorises_and_keeps_iterates():
+    V, F = icosphere(2)
+    V = V + 0.02 * np.random.default_rng(12).standard_normal(V.shape)
+    steps = [0.01, 0.1, 1.0]
+    S = ImplicitSmoother(V, F, cache_size=1, history_size=1).prepare(steps, iterations=3)
+    assert len(S._lu) == 3 and len(S._history) == 3
+    for s in steps:
+        np.testing.assert_allclose(S.smooth(s, 3), implicit_smoothing(V, F, s, 3), atol=1e-14)
+        np.testing.assert_allclose(S.smooth(s, 4), implicit_smoothing(V, F, s, 4), atol=1e-14)
