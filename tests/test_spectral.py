@@ -83,15 +83,36 @@ def test_first_eigenvector_is_the_constant(egg):
     np.testing.assert_allclose(E[:, 0], 1.0 / np.sqrt(m.sum()), rtol=1e-12)
 
 
-def test_dense_and_sparse_agree(egg):
+@pytest.mark.parametrize("method", ["sparse", "arpack"])
+def test_dense_and_sparse_agree(egg, method):
     V, F = egg
     ld, Ed = eigenbasis(V, F, 30, method="dense", cache=False)
-    ls, Es = eigenbasis(V, F, 30, method="sparse", cache=False)
+    ls, Es = eigenbasis(V, F, 30, method=method, cache=False)
     np.testing.assert_allclose(ls, ld, rtol=1e-9, atol=1e-9)
     # simple eigenvalues here, and the sign convention fixes each vector
     m, _ = _mass(V, F)
     G = Ed.T @ (m[:, None] * Es)
     np.testing.assert_allclose(np.diag(G), 1.0, atol=1e-7)
+
+
+@pytest.mark.parametrize("block", [1, 4, 7])
+def test_block_lanczos_on_a_diagonal_operator(block):
+    """Known spectrum with repeated values (multiplicity above the block size, too)."""
+    rng = np.random.default_rng(5)
+    n = 400
+    d = np.concatenate([np.full(9, 50.0), 10.0 / (1.0 + np.arange(n - 9))])  # like a shift-inverted spectrum
+    rng.shuffle(d)
+    theta, Y = spectral.block_lanczos(lambda X: d[:, None] * X, n, 30, block=block)
+    np.testing.assert_allclose(theta, np.sort(d)[::-1][:30], rtol=1e-10)
+    assert np.abs(Y.T @ Y - np.eye(30)).max() < 1e-10
+    assert np.abs(d[:, None] * Y - Y * theta).max() < 1e-9
+
+
+def test_nested_dissection_is_a_permutation(egg_fine):
+    V, F = egg_fine
+    _, C = laplacian(V, F)
+    p = spectral.nested_dissection(C, V)
+    assert np.array_equal(np.sort(p), np.arange(len(V)))
 
 
 def test_unit_sphere_eigenvalues_are_l_l_plus_1():
@@ -286,6 +307,13 @@ def test_isolated_vertex_is_named(egg):
 def test_bad_method(egg):
     with pytest.raises(MeshError, match="method"):
         eigenbasis(*egg, 5, method="lobster")
+
+
+def test_sparse_agrees_with_arpack_at_2562_vertices(egg_fine):
+    V, F = egg_fine
+    lb, Eb = eigenbasis(V, F, 60, method="sparse", cache=False)
+    la_, Ea = eigenbasis(V, F, 60, method="arpack", cache=False)
+    np.testing.assert_allclose(lb, la_, rtol=1e-10, atol=1e-12)
 
 
 def test_k_beyond_basis_in_reconstruct(egg):
