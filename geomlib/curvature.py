@@ -186,6 +186,9 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
     if boundary != "formula":
         on_boundary = _boundary_mask(F, len(V))
         H[on_boundary] = np.nan if boundary == "nan" else 0.0
+        if on_boundary.all():
+            _warn(f"every vertex of this mesh lies on the boundary; boundary={boundary!r} gives "
+                  f"{'NaN' if boundary == 'nan' else '0'} everywhere (boundary='formula' keeps the values)")
     return H
 
 

@@ -266,6 +266,9 @@ def test_bow_tie_boundary_vertex_and_non_manifold_edge():
         K = gaussian_curvature(V, F)
     assert np.isnan(K).all()
     with pytest.warns(MeshWarning, match="every vertex"):
+        assert np.isnan(mean_curvature(V, F, boundary="nan")).all()
+    assert np.isfinite(mean_curvature(V, F)).all()
+    with pytest.warns(MeshWarning, match="every vertex"):
         turning = gaussian_curvature(V, F, boundary="turning", integrated=True)
     # chi = 5 - 6 + 2 = 1; vertex 0 has four boundary edges: 2 pi - 2 pi - pi/2 - pi/2
     assert turning[0] == pytest.approx(-np.pi, abs=1e-12)
