@@ -94,9 +94,6 @@ class AnalyticMesh:
         Exact mean (1/length) and Gaussian (1/length^2) curvature.
     k1, k2 : (n,) float64
         Exact principal curvatures, ``k1 >= k2``.
-
-    ``N``, ``H``, ``K``, ``k1``, ``k2`` are evaluated (from geomlib.symbolic)
-    on first access and then kept.
     uv : (n, 2) float64 or None
         Parameter values of each vertex (see the surface's function for the
         parametrisation), None where the surface has no global parametrisation.
@@ -105,6 +102,10 @@ class AnalyticMesh:
     area, volume : float or None
         Exact area and enclosed volume of the smooth surface (None if not known
         in closed form or not enclosed).
+    truth : callable
+        Returns (N, H, K, k1, k2); called once, on the first access to any of
+        them (so a mesh that is only written to a file never compiles the
+        symbolic expressions). The values are kept.
 
     The arrays belong to the object: copy them before changing them in place.
     """
