@@ -674,7 +674,8 @@ def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
             _remember(key, basis)
             return basis
     t0 = time.perf_counter()
-    dense = method == "dense" or (method == "auto" and (n <= DENSE_MAX_VERTICES or 3 * k > n))
+    # ARPACK and the block solver need k well below n; near k = n only LAPACK makes sense
+    dense = method == "dense" or k >= n - 1 or (method == "auto" and (n <= DENSE_MAX_VERTICES or 3 * k > n))
     with _blas_threads(BLAS_THREADS):
         if dense:
             lam, Y = _dense(m, C, k)
