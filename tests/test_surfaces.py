@@ -527,3 +527,16 @@ def test_truth_is_computed_on_first_access_and_kept():
     assert "_values" not in m.__dict__
     H = m.H
     assert "_values" in m.__dict__ and m.H is H
+
+
+@pytest.mark.parametrize("make", [lambda: S.ellipsoid(1.0, 0.7, 0.5, subdivisions=2), lambda: S.uv_ellipsoid(1.0, 0.7, 0.5, n=6)])
+def test_ellipsoid_truth_at_the_poles(make):
+    # the parametrisation is singular at v = 0, pi; the truth there is still exact:
+    # normal +-z, principal curvatures c / a^2 and c / b^2
+    m = make()
+    poles = np.flatnonzero(np.abs(m.V[:, 2]) == 0.5)
+    assert poles.size == 2
+    np.testing.assert_allclose(m.N[poles], [[0, 0, np.sign(z)] for z in m.V[poles, 2]], atol=1e-15)
+    np.testing.assert_allclose(m.k1[poles], 0.5 / 0.7**2, rtol=1e-7)
+    np.testing.assert_allclose(m.k2[poles], 0.5 / 1.0**2, rtol=1e-7)
+    np.testing.assert_allclose(m.K[poles], 0.5**2 / (0.7**2 * 1.0**2), rtol=1e-13)
