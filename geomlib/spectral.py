@@ -129,7 +129,7 @@ def _operator(V, F, weights, area):
 
 
 def _components(F, m, n):
-    """Component label per vertex, through faces of non-zero area, largest first."""
+    """Number of connected components (vertices linked by faces) and a label per vertex, largest area first."""
     from scipy.sparse.csgraph import connected_components
 
     if len(F):
