@@ -143,6 +143,13 @@ def test_creature_is_a_sphere_topologically():
     assert m.euler_number == 2
     angles = np.degrees(m.face_angles)
     assert angles.min() > 1.0
+    # no face folded over by the clean-up: every face normal agrees with the
+    # gradient of the implicit function, and vertices stay near its zero set
+    C = V[F].mean(axis=1)
+    e = 1e-5
+    g = np.stack([(mm.creature_field(C + e * d) - mm.creature_field(C - e * d)) / (2 * e) for d in np.eye(3)], 1)
+    assert np.all(np.einsum("ij,ij->i", m.face_normals, g / np.linalg.norm(g, axis=1, keepdims=True)) > 0.1)
+    assert np.abs(mm.creature_field(V)).max() < mm.CREATURE_CLAMP * mm.CREATURE_SPACING
 
 
 def test_analytic_meshes_lie_on_their_surfaces():
