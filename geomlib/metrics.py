@@ -747,7 +747,7 @@ SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"),
 EXPLICIT_FRACTIONS = (0.1, 0.25, 0.5, 0.9)
 
 #: Implicit steps of the sweep, scale-free (see :func:`scale_free_step`).
-IMPLICIT_STEPS = (0.1, 0.3, 1.0, 3.0)
+IMPLICIT_STEPS = (0.1, 0.3, 1.0)
 
 #: Iteration counts at which the sweep measures every run.
 SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
