@@ -272,6 +272,24 @@ def shutdown_kernel(page):
         pass
 
 
+def stable_screenshot(locator, tries=20, pause=0.15):
+    """Screenshot of an element once its position stopped moving (Lab keeps
+    laying out while MathJax typesets and outputs above it grow)."""
+    locator.scroll_into_view_if_needed()
+    box = locator.bounding_box()
+    png = None
+    for _ in range(tries):
+        time.sleep(pause)
+        again = locator.bounding_box()
+        if again == box:
+            png = locator.screenshot()
+            if locator.bounding_box() == box:
+                return png
+            again = locator.bounding_box()
+        box = again
+    return png if png is not None else locator.screenshot()
+
+
 def image_stats(png_bytes, background=(255, 255, 255)):
     """(distinct colours, fraction of pixels differing from the background)."""
     import numpy as np

@@ -76,7 +76,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             shot = {}
 
             def rendered(i=i, canvas=canvas):
-                shot["png"] = canvas.screenshot()
+                shot["png"] = lablib.stable_screenshot(canvas)
                 return _not_blank(shot["png"])[0]
 
             ok = _wait_for(rendered, RENDER_TIMEOUT)
@@ -91,7 +91,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             f"{notebook}: no slider shares an ipywidgets box or a cell with a view; put them in one box, "
             "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/viewer.py)")
         box_canvases = page.locator("[data-geomlib-box] .geomlib-canvas")
-        before = [box_canvases.nth(i).screenshot() for i in range(box_canvases.count())]
+        before = [lablib.stable_screenshot(box_canvases.nth(i)) for i in range(box_canvases.count())]
         handle = page.locator("[data-geomlib-slider] .noUi-handle").first
         handle.scroll_into_view_if_needed()
         handle.focus()
@@ -100,7 +100,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         moved = {}
 
         def changed():
-            moved["after"] = [box_canvases.nth(i).screenshot() for i in range(box_canvases.count())]
+            moved["after"] = [lablib.stable_screenshot(box_canvases.nth(i)) for i in range(box_canvases.count())]
             moved["fraction"] = max(lablib.changed_fraction(a, b) for a, b in zip(before, moved["after"]))
             return moved["fraction"] > 0.005
 
@@ -121,14 +121,15 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 continue
             first, second = views.nth(0), views.nth(1)
             first.scroll_into_view_if_needed()
-            before = second.screenshot()
+            before = lablib.stable_screenshot(second)
             box = first.bounding_box()
             x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
             page.mouse.move(x, y)
             page.mouse.down()
             page.mouse.move(x + 90, y + 40, steps=10)
             page.mouse.up()
-            ok = _wait_for(lambda: lablib.changed_fraction(before, second.screenshot()) > 0.005, RENDER_TIMEOUT)
+            ok = _wait_for(lambda: lablib.changed_fraction(before, lablib.stable_screenshot(second)) > 0.005,
+                           RENDER_TIMEOUT)
             (screenshot_dir / f"row{r}_linked.png").write_bytes(second.screenshot())
             assert ok, f"{notebook}: orbiting the first view of side_by_side row {r} did not turn the second"
     finally:
