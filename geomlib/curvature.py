@@ -252,7 +252,7 @@ def _deficits_and_probes(V, F, n, area):
     columns = (V[:, 0], V[:, 1], V[:, 2])  # strided views: no copy of V per block
     for start in range(0, m, step):
         Fb = F[start:start + step]
-        l2, dblA, cot, degenerate = _geometry(V, Fb, columns)
+        l2, dblA, cot, degenerate = _geometry(V, Fb, columns, with_cot=(area == "mixed"))
         any_degenerate |= bool(degenerate.any())
         theta = _angles(l2, dblA, degenerate)
         Ft = Fb.T

@@ -76,7 +76,7 @@ def _check_options(weights=None, area=None):
         raise MeshError(f"area must be 'barycentric' or 'mixed', not {area!r}")
 
 
-def _geometry(V, F, columns=None):
+def _geometry(V, F, columns=None, with_cot=True):
     """Face geometry in (3, m) layout (one row per corner): l2, dblA, cot, degenerate.
 
     Computed coordinate by coordinate on contiguous arrays (no np.cross, no
@@ -104,6 +104,8 @@ def _geometry(V, F, columns=None):
     nz = by * cx - bx * cy
     dblA = np.sqrt(nx * nx + ny * ny + nz * nz)
     degenerate = dblA <= ZERO_AREA_RTOL * l2.max(axis=0)
+    if not with_cot:  # callers that need only lengths and areas (angle sums, barycentric areas)
+        return l2, dblA, None, degenerate
     # cot(angle at i) = <e_j, e_k> / |e_j x e_k| = (l_j^2 + l_k^2 - l_i^2) / (2 * 2A)
     denom = 2.0 * np.where(degenerate, 1.0, dblA)
     s = l2.sum(axis=0)
