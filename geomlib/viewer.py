@@ -58,14 +58,19 @@ viewer's eye, both sides of the surface lit), not by three.js lights: a
 t.on is not a function" once per view in the browser console (harmless, nothing
 visible is wrong), and a light fixed to the camera cannot be shared by views
 whose cameras are linked. The colours on screen are the colour map's own
-colours times the shading factor, so they match the colour bar.
+colours times the shading factor, so they match the colour bar. On a closed,
+outward-oriented mesh back faces are skipped (they cannot be seen from
+outside; the software WebGL of headless browsers draws large meshes about
+twice as fast); open or inconsistently oriented meshes show both sides.
 
 Without a front-end
 -------------------
 ``display(view)`` gives the widget together with a still picture (image/png,
 drawn by a small numpy z-buffer rasteriser from the same camera direction, with
 the colour bar) and a one-line text summary, so nbval, exported HTML and
-repository previews still show the mesh.
+repository previews still show the mesh. (``jupyter nbconvert --to html``
+shows the still unless the notebook was saved with its widget state; with the
+state it embeds the live widget, which needs the widget scripts from a CDN.)
 """
 
 import base64
