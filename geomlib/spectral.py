@@ -252,17 +252,22 @@ _HANDLES = {}
 def _openblas_handles():
     """(set, get) function pairs of every OpenBLAS loaded in this process (Linux only; else []).
 
-    Looked up once per set of loaded libraries (a module imported later may load another one)."""
+    The loaded libraries are listed again only when modules were imported since
+    the last look (an import may load another BLAS), so a slider callback does
+    not pay for reading /proc/self/maps."""
+    stamp = len(sys.modules)
+    if _HANDLES.get("stamp") == stamp:
+        return _HANDLES["handles"]
     try:
         with open("/proc/self/maps") as maps:
             paths = tuple(sorted({line.split()[-1] for line in maps
                                   if "openblas" in line.rsplit("/", 1)[-1].lower()}))
     except OSError:
-        return []
-    if paths not in _HANDLES:
-        _HANDLES.clear()
-        _HANDLES[paths] = _load_handles(paths)
-    return _HANDLES[paths]
+        paths = ()
+    if _HANDLES.get("paths") != paths:
+        _HANDLES.update(paths=paths, handles=_load_handles(paths))
+    _HANDLES["stamp"] = stamp
+    return _HANDLES["handles"]
 
 
 def _load_handles(paths):
