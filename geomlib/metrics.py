@@ -479,8 +479,11 @@ class MeshComparison:
         surface, each measured exactly to the other surface (closest point in
         a triangle, on an edge or at a corner). Being a maximum over finitely
         many points it is an estimate *from below*: the true value is at least
-        this and exceeds it by at most the distance between neighbouring
-        samples. Relative to the clean diagonal by default.
+        this, and since ``d(p, S)`` changes by at most ``|p - q|`` from p to q
+        it exceeds the estimate by at most the covering radius of the samples
+        (the largest distance from a point of a surface to its nearest
+        sample), which shrinks as the density grows. Relative to the clean
+        diagonal by default.
         """
         V = self._check(V)
         if self._index_clean is None:
@@ -614,8 +617,10 @@ def hausdorff_distance(V, V_clean, F, F_clean=None, relative=True,
     measured *exactly* to the other surface (closest point in a triangle, on
     an edge or at a corner), so the result is the exact maximum over those
     points: an estimate from below of the true Hausdorff distance, short of it
-    by at most the spacing of the samples. With ``samples_per_face=0`` it is
-    the exact vertex-to-surface Hausdorff distance.
+    by at most the covering radius of the samples (the largest distance from
+    a point of a surface to its nearest sample; ``d(p, S)`` is 1-Lipschitz in
+    p). With ``samples_per_face=0`` it is the largest distance from a vertex
+    of either mesh to the other surface, exactly.
 
     Parameters
     ----------
