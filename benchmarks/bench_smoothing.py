@@ -50,7 +50,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 ITERATIONS = 10
-SLIDER_ITERATIONS = 5      # notebook 06's default
+SLIDER_ITERATIONS = 5      # iterations behind each slider setting (notebook 06 starts at 3)
 STEP_SCALE_FREE = 10.0
 
 
