@@ -113,25 +113,37 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         state = page.evaluate(lablib.JS_STATE)
         assert not state["errors"], f"the slider callback raised:\n{_format_errors(state['errors'])}"
 
-        # 5: linked cameras turn together
+        # 5: linked cameras turn together (after the slider's work has finished)
+        _wait_for(lambda: page.evaluate(lablib.JS_STATE)["kernel"] == "idle", RUN_TIMEOUT)
+        time.sleep(1.0)
         rows = page.locator(".geomlib-row")
         for r in range(rows.count()):
             views = rows.nth(r).locator(".geomlib-canvas")
             if views.count() < 2:
                 continue
             first, second = views.nth(0), views.nth(1)
-            first.scroll_into_view_if_needed()
-            before = lablib.stable_screenshot(second)
-            box = first.bounding_box()
-            x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-            page.mouse.move(x, y)
-            page.mouse.down()
-            page.mouse.move(x + 90, y + 40, steps=10)
-            page.mouse.up()
-            ok = _wait_for(lambda: lablib.changed_fraction(before, lablib.stable_screenshot(second)) > 0.005,
-                           RENDER_TIMEOUT)
+            turned = followed = False
+            for attempt in range(3):          # a drag can miss while the page is still laying out
+                before_first = lablib.stable_screenshot(first)
+                before_second = lablib.stable_screenshot(second)
+                box = first.bounding_box()
+                x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+                page.mouse.move(x, y)
+                page.mouse.down()
+                page.mouse.move(x + 90, y + 40, steps=10)
+                page.mouse.up()
+                turned = _wait_for(
+                    lambda: lablib.changed_fraction(before_first, lablib.stable_screenshot(first)) > 0.005, 10)
+                if not turned:
+                    continue
+                followed = _wait_for(
+                    lambda: lablib.changed_fraction(before_second, lablib.stable_screenshot(second)) > 0.005,
+                    RENDER_TIMEOUT)
+                break
             (screenshot_dir / f"row{r}_linked.png").write_bytes(second.screenshot())
-            assert ok, f"{notebook}: orbiting the first view of side_by_side row {r} did not turn the second"
+            assert turned, f"{notebook}: an orbit drag did not turn the first view of side_by_side row {r}"
+            assert followed, (f"{notebook}: orbiting the first view of side_by_side row {r} "
+                              "did not turn the second (cameras not linked)")
     finally:
         (screenshot_dir / "console.txt").write_text("\n".join(console))
         lablib.shutdown_kernel(page)
