@@ -74,6 +74,8 @@ def main(argv):
         return 0
     if command == "lab":
         cmd = [BIN / "jupyter", "lab", "--notebook-dir", ROOT / "notebooks", *rest]
+        if hasattr(os, "geteuid") and os.geteuid() == 0 and "--allow-root" not in rest:
+            cmd.append("--allow-root")  # containers and CI machines often run as root
         print("+", " ".join(str(c) for c in cmd), flush=True)
         return subprocess.call([str(c) for c in cmd], cwd=ROOT / "notebooks", env=env)
     cmd = [PY, "-m", "pytest", *rest]
