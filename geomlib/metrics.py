@@ -31,7 +31,8 @@ Degenerate and special cases are stated where they are handled:
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .errors import MeshError, format_indices
+from .errors import MeshError
+from .validate import as_faces, as_vertices
 
 #: Default threshold (degrees) on the clean mesh's dihedral (bend) angle above
 #: which an edge counts as a sharp feature edge.
@@ -45,37 +46,6 @@ HAUSDORFF_SAMPLES_PER_FACE = 2.0
 # ----------------------------------------------------------------------------
 # checks
 # ----------------------------------------------------------------------------
-
-def _as_vertices(V, name="V"):
-    V = np.asarray(V)
-    if V.ndim != 2 or V.shape[1] != 3:
-        raise MeshError(f"{name} must be an (n, 3) array of vertex positions, got shape {V.shape}")
-    if len(V) == 0:
-        raise MeshError(f"{name} has no vertices")
-    if not np.issubdtype(V.dtype, np.number):
-        raise MeshError(f"{name} must be numeric, got dtype {V.dtype}")
-    V = V.astype(np.float64, copy=False)
-    bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-    if len(bad):
-        raise MeshError(f"{name} has non-finite coordinates at vertices {format_indices(bad)}")
-    return V
-
-
-def _as_faces(F, n, name="F"):
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3:
-        raise MeshError(f"{name} must be an (m, 3) array of triangles, got shape {F.shape}")
-    if len(F) == 0:
-        raise MeshError(f"{name} has no faces")
-    if not np.issubdtype(F.dtype, np.integer):
-        raise MeshError(f"{name} must hold integer vertex indices, got dtype {F.dtype}")
-    F = F.astype(np.int64, copy=False)
-    out = ((F < 0) | (F >= n)).any(axis=1)
-    if out.any():
-        raise MeshError(f"{name} refers to vertices outside 0..{n - 1} in faces "
-                        f"{format_indices(np.flatnonzero(out))}")
-    return F
-
 
 def _same_shape(V, V_clean):
     if V.shape != V_clean.shape:
@@ -95,7 +65,7 @@ def bounding_box_diagonal(V):
     float
         ``|max(V) - min(V)|`` taken over the three axes.
     """
-    V = _as_vertices(V)
+    V = as_vertices(V)
     return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
 
 
@@ -121,8 +91,8 @@ def _norms(X):
 
 def surface_area(V, F):
     """Total area of the triangles (length^2)."""
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
     return 0.5 * float(np.linalg.norm(_cross_faces(V, F), axis=1).sum())
 
 
@@ -131,8 +101,8 @@ def enclosed_volume(V, F):
     ``1/6 sum_f v0 . (v1 x v2)``: positive for a closed mesh whose faces are
     counter-clockwise seen from outside. Only meaningful for a closed mesh
     (on an open one it depends on the origin); this function does not check."""
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
     return float(np.einsum("ij,ij->", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])) / 6.0)
 
 
@@ -201,8 +171,8 @@ def dihedral_angles(V, F, edges=None):
     E : (k, 2) int64 edge vertex indices (interior edges only).
     angle : (k,) float64 signed bend angle in degrees, in (-180, 180].
     """
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
     if edges is None:
         E, f1, f2, _, _ = interior_edges(F)
     else:
@@ -349,9 +319,9 @@ def point_surface_distance(P, V, F):
     k-d tree over triangle centroids to find the candidate triangles. Length
     units of the mesh.
     """
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
-    P = _as_vertices(P, "P")
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
+    P = as_vertices(P, where="P")
     return _SurfaceIndex(V, F).distance(P)
 
 
@@ -362,8 +332,8 @@ def sample_surface(V, F, count, seed):
     uniformly inside it (the square-root rule for barycentric coordinates).
     Returns ``(count, 3)`` float64.
     """
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
     return _sample(V, F, int(count), np.random.default_rng(seed))
 
 
@@ -421,8 +391,8 @@ class MeshComparison:
 
     def __init__(self, V_clean, F, sharp_angle=SHARP_ANGLE,
                  samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
-        self.V_clean = _as_vertices(V_clean, "V_clean").copy()
-        self.F = _as_faces(F, len(self.V_clean))
+        self.V_clean = as_vertices(V_clean, where="V_clean").copy()
+        self.F = as_faces(F, len(self.V_clean))
         self.diagonal = bounding_box_diagonal(self.V_clean)
         if not self.diagonal > 0:
             raise MeshError("the clean mesh has a zero bounding-box diagonal (all vertices coincide)")
@@ -445,7 +415,7 @@ class MeshComparison:
     # -- single metrics ------------------------------------------------------
 
     def _check(self, V):
-        V = _as_vertices(V)
+        V = as_vertices(V)
         _same_shape(V, self.V_clean)
         return V
 
@@ -598,8 +568,8 @@ def vertex_rms(V, V_clean, relative=True):
     -------
     float
     """
-    V = _as_vertices(V)
-    V_clean = _as_vertices(V_clean, "V_clean")
+    V = as_vertices(V)
+    V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
     rms = float(np.sqrt(np.mean(np.einsum("ij,ij->i", V - V_clean, V - V_clean))))
     return rms / bounding_box_diagonal(V_clean) if relative else rms
@@ -636,10 +606,10 @@ def hausdorff_distance(V, V_clean, F, F_clean=None, relative=True,
     -------
     float
     """
-    V = _as_vertices(V)
-    V_clean = _as_vertices(V_clean, "V_clean")
-    F = _as_faces(F, len(V))
-    F_clean = F if F_clean is None else _as_faces(F_clean, len(V_clean), "F_clean")
+    V = as_vertices(V)
+    V_clean = as_vertices(V_clean, where="V_clean")
+    F = as_faces(F, len(V))
+    F_clean = F if F_clean is None else as_faces(F_clean, len(V_clean), where="F_clean")
     rng = np.random.default_rng(seed)
 
     def points(X, G):
@@ -658,10 +628,10 @@ def face_normal_angles(V, V_clean, F):
     ``atan2(|n x n_clean|, n . n_clean)`` in [0, 180] (accurate for small
     angles too); a face of zero area in either mesh counts as 90.
     """
-    V = _as_vertices(V)
-    V_clean = _as_vertices(V_clean, "V_clean")
+    V = as_vertices(V)
+    V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
-    F = _as_faces(F, len(V))
+    F = as_faces(F, len(V))
     return _normal_angles(_cross_faces(V, F), _cross_faces(V_clean, F))
 
 
@@ -690,10 +660,10 @@ def volume_change(V, V_clean, F):
     Closed meshes only (every edge shared by two opposite faces); an open
     mesh raises MeshError naming its boundary edges.
     """
-    V = _as_vertices(V)
-    V_clean = _as_vertices(V_clean, "V_clean")
+    V = as_vertices(V)
+    V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
-    F = _as_faces(F, len(V))
+    F = as_faces(F, len(V))
     _, _, _, boundary, other = interior_edges(F)
     if len(boundary) or len(other):
         bad = np.vstack([boundary, other])
@@ -726,10 +696,10 @@ def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE):
     :func:`dihedral_angles`. Returns NaN when the clean mesh has no sharp
     edge (there is nothing to measure).
     """
-    V = _as_vertices(V)
-    V_clean = _as_vertices(V_clean, "V_clean")
+    V = as_vertices(V)
+    V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
-    F = _as_faces(F, len(V))
+    F = as_faces(F, len(V))
     return MeshComparison(V_clean, F, sharp_angle=threshold).sharp_edge_error(V)
 
 
@@ -774,8 +744,8 @@ def mean_edge_length(V, F, edges=None):
     """Mean length of the mesh's edges, each counted once (length units).
 
     ``edges``: the result of :func:`unique_edges` for F, to avoid recomputing it."""
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
     E = unique_edges(F) if edges is None else edges
     return float(_norms(V[E[:, 0]] - V[E[:, 1]]).mean())
 

@@ -12,7 +12,8 @@ noise, bit for bit, and the input arrays are never modified.
 import numpy as np
 
 from .errors import MeshError
-from .metrics import _as_faces, _as_vertices, bounding_box_diagonal
+from .metrics import bounding_box_diagonal
+from .validate import as_faces, as_vertices
 
 DIRECTIONS = ("isotropic", "normal")
 
@@ -50,8 +51,8 @@ def add_noise(V, F, sigma, seed, direction="isotropic"):
     (n, 3) float64
         A new array; the input is never modified.
     """
-    V = _as_vertices(V)
-    F = _as_faces(F, len(V))
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
     try:
         sigma = float(sigma)
     except (TypeError, ValueError):
