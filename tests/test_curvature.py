@@ -9,9 +9,7 @@ import pytest
 from geomlib import (MeshError, MeshWarning, gaussian_curvature, load_mesh, mean_curvature,
                      principal_curvatures, surfaces)
 from geomlib.curvature import BOUNDARY_RULES, angle_sums, boundary_mask
-
-SHIPPED = Path(__file__).resolve().parents[1] / "meshes"
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+from meshdata import COURSE, COURSE_MESHES, SHIPPED, needs_course
 
 
 def euler_characteristic(V, F):
@@ -320,10 +318,7 @@ def test_libigl_gaussian_curvature_shipped(name):
         _against_libigl(*load_mesh(SHIPPED / name))
 
 
-COURSE_MESHES = sorted(str(p.relative_to(COURSE)) for p in COURSE.rglob("*.obj")) if COURSE.is_dir() else []
-
-
-@pytest.mark.skipif(not COURSE.is_dir(), reason="the course meshes (../shared/meshes) are not present")
+@needs_course
 @pytest.mark.parametrize("name", COURSE_MESHES)
 def test_libigl_gaussian_curvature_course(name):
     with warnings.catch_warnings():

@@ -14,9 +14,7 @@ import trimesh
 
 from geomlib import MeshError, MeshReport, MeshWarning, load_mesh, save_mesh
 from geomlib.io import _obj_fast, _obj_slow
-
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
-needs_course = pytest.mark.skipif(not COURSE.is_dir(), reason="course meshes not present")
+from meshdata import COURSE, needs_course
 
 
 def write(tmp_path, name, text):

@@ -10,9 +10,8 @@ import trimesh
 
 from geomlib import MeshError, MeshWarning, cotangent_weights, laplacian, load_mesh, vertex_areas
 from geomlib import surfaces
+from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, needs_course
 
-SHIPPED = Path(__file__).resolve().parents[1] / "meshes"
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
 
 AREAS = ("barycentric", "mixed")
 
@@ -279,9 +278,6 @@ def test_libigl_generated(name):
     _against_libigl(*MESHES[name]())
 
 
-SHIPPED_MESHES = sorted(p.name for p in SHIPPED.glob("*.obj"))
-
-
 @pytest.mark.parametrize("name", SHIPPED_MESHES)
 def test_libigl_shipped_meshes(name):
     with warnings.catch_warnings():
@@ -289,10 +285,7 @@ def test_libigl_shipped_meshes(name):
         _against_libigl(*load_mesh(SHIPPED / name))
 
 
-COURSE_MESHES = sorted(str(p.relative_to(COURSE)) for p in COURSE.rglob("*.obj")) if COURSE.is_dir() else []
-
-
-@pytest.mark.skipif(not COURSE.is_dir(), reason="the course meshes (../shared/meshes) are not present")
+@needs_course
 @pytest.mark.parametrize("name", COURSE_MESHES)
 def test_libigl_course_meshes(name):
     with warnings.catch_warnings():

@@ -13,8 +13,7 @@ from geomlib import (MeshError, MeshWarning, explicit_smoothing, explicit_step_l
                      implicit_smoothing, laplacian)
 from geomlib.smoothing import (ImplicitSmoother, _boundary_mask, _volume_centroid,
                                highest_frequency_mode)
-
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+from meshdata import COURSE
 
 
 def icosphere(subdivisions=2, radius=1.0, centre=(0.0, 0.0, 0.0)):

@@ -19,8 +19,7 @@ from geomlib import (
     spectral_reconstruction,
 )
 from geomlib.surfaces import ellipsoid, icosphere, sphere
-
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+from meshdata import COURSE
 
 
 @pytest.fixture(autouse=True)

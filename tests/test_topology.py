@@ -19,9 +19,7 @@ from geomlib import (
     valence,
     vertex_face_adjacency,
 )
-
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
-needs_course = pytest.mark.skipif(not COURSE.is_dir(), reason="course meshes not present")
+from meshdata import COURSE, needs_course
 
 
 # ---------------------------------------------------------------- small meshes

@@ -8,9 +8,7 @@ import trimesh
 
 from geomlib import MeshError, MeshReport, check_mesh, load_mesh
 from geomlib.validate import as_faces, as_mesh
-
-COURSE = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
-needs_course = pytest.mark.skipif(not COURSE.is_dir(), reason="course meshes not present")
+from meshdata import COURSE, needs_course
 
 
 def icosahedron():
