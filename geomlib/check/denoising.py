@@ -1,0 +1,3 @@
+"""Checks of the exercises of notebook 07."""
+
+__all__ = []

@@ -1,0 +1,3 @@
+"""Checks of the exercises of notebook 05."""
+
+__all__ = []

@@ -1,0 +1,3 @@
+"""Checks of the exercises of notebook 02."""
+
+__all__ = []

@@ -1,0 +1,87 @@
+"""Smoothing as filtering: what one step of each scheme does to one eigenmode.
+
+Write the vertex positions in the eigenbasis of the Laplace-Beltrami operator,
+P = sum_i E_i c_i with C E_i = -lam_i M E_i (lam_i >= 0, notebook 04). Every
+linear smoothing step below multiplies each coefficient c_i by a factor that
+depends only on tau lam_i, tau being the step (length^2 for the cotangent
+operator; a pure number for the uniform one):
+
+* exact diffusion for time tau:      exp(-tau lam)
+* explicit (forward Euler) step:     1 - tau lam           (|.| < 1 needs tau lam < 2)
+* implicit (backward Euler) step:    1 / (1 + tau lam)     (in (0, 1] for every tau)
+* Crank-Nicolson step:               (1 - tau lam / 2) / (1 + tau lam / 2)
+* Taubin's pass (Taubin 1995):       (1 - tau_shrink lam)(1 - tau_inflate lam),
+  tau_shrink > 0 > tau_inflate, |tau_inflate| slightly larger.
+
+Since 1 / (1 + x) > exp(-x) > 1 - x for every x > 0, an implicit step damps
+every mode less than exact diffusion for the same time, and the explicit step
+more (until it overshoots past x = 1 and diverges past x = 2).
+"""
+
+import numpy as np
+
+__all__ = ["SCHEMES", "mode_factor", "plot_mode_factors"]
+
+SCHEMES = ("diffusion", "explicit", "implicit", "crank-nicolson", "taubin")
+
+
+def mode_factor(lam, tau, scheme, tau_inflate=None):
+    """Factor applied to the coefficient of eigenmode lam by one step of ``scheme``.
+
+    Parameters
+    ----------
+    lam : array_like, eigenvalues of -M^-1 C (>= 0; 1/length^2 for cotan).
+    tau : float, the step (length^2 for cotan); for "taubin" the shrink factor.
+    scheme : one of SCHEMES.
+    tau_inflate : float, Taubin's (negative) inflate factor; only for "taubin".
+
+    Returns
+    -------
+    ndarray of the shape of ``lam``.
+    """
+    x = tau * np.asarray(lam, dtype=float)
+    if scheme == "diffusion":
+        return np.exp(-x)
+    if scheme == "explicit":
+        return 1.0 - x
+    if scheme == "implicit":
+        return 1.0 / (1.0 + x)
+    if scheme == "crank-nicolson":
+        return (1.0 - x / 2) / (1.0 + x / 2)
+    if scheme == "taubin":
+        if tau_inflate is None or not tau_inflate < 0 < tau:
+            raise ValueError("Taubin's pass needs tau > 0 (shrink) and tau_inflate < 0 (inflate)")
+        return (1.0 - x) * (1.0 - tau_inflate * np.asarray(lam, dtype=float))
+    raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+
+
+def plot_mode_factors(lam_min, lam_max, tau, taubin=None, ax=None, title=None):
+    """Plot the per-mode factor of each scheme against lam, with the mesh's eigenvalue range shaded.
+
+    Parameters
+    ----------
+    lam_min, lam_max : float, smallest non-zero and largest eigenvalue of the mesh's operator.
+    tau : float, the step of the explicit, implicit and Crank-Nicolson schemes and of diffusion.
+    taubin : (tau_shrink, tau_inflate), optional, Taubin's pair in the same operator's units.
+    ax : matplotlib axes, optional.
+
+    Returns the axes.
+    """
+    import matplotlib.pyplot as plt
+
+    ax = ax or plt.subplots(figsize=(7, 3.6))[1]
+    lam = np.linspace(0.0, 1.15 * lam_max, 600)
+    for scheme, style in (("diffusion", "k-"), ("explicit", "C3-"), ("implicit", "C0-"),
+                          ("crank-nicolson", "C2--")):
+        ax.plot(lam, mode_factor(lam, tau, scheme), style, lw=1.4, label=scheme)
+    if taubin is not None:
+        ax.plot(lam, mode_factor(lam, taubin[0], "taubin", taubin[1]), "C1-", lw=1.4,
+                label=f"Taubin ({taubin[0]:.3g}, {taubin[1]:.3g})")
+    ax.axvspan(lam_min, lam_max, color="0.9", zorder=0, label="this mesh's eigenvalues")
+    ax.axhline(0, color="0.5", lw=0.6)
+    for y in (-1, 1):
+        ax.axhline(y, color="0.5", lw=0.6, ls=":")
+    ax.set(xlabel=r"eigenvalue $\lambda$", ylabel="factor per step", ylim=(-2.2, 1.2),
+           title=title or rf"one step, $\tau$ = {tau:.3g}")
+    ax.legend(fontsize=8, loc="lower left")
+    return ax

@@ -1,0 +1,66 @@
+"""Elementary measurements of a triangle mesh: one home for each.
+
+Machinery shared by the lessons, the metrics, the smoothers and the viewer:
+face normals and areas, total area, enclosed volume, bounding-box diagonal,
+mean edge length. Inputs are validated by ``validate.as_mesh``; lengths are in
+the mesh's own units.
+"""
+
+import numpy as np
+
+from .topology import edges
+from .validate import as_faces, as_mesh, as_vertices
+
+__all__ = ["face_cross", "face_areas", "face_normals", "surface_area", "enclosed_volume",
+           "bounding_box_diagonal", "mean_edge_length"]
+
+
+def face_cross(V, F):
+    """(m, 3) float64: ``(v1 - v0) x (v2 - v0)`` per face, which is 2 A_f n_f (unchecked input)."""
+    return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+
+
+def face_areas(V, F):
+    """(m,) float64: triangle areas A_f = |(v1 - v0) x (v2 - v0)| / 2 (length^2)."""
+    V, F = as_mesh(V, F)
+    return 0.5 * np.linalg.norm(face_cross(V, F), axis=1)
+
+
+def face_normals(V, F):
+    """(m, 3) float64: unit face normals, right-handed in the corner order (outward for CCW faces).
+
+    A zero-area face has no normal: its row is (0, 0, 0), not NaN.
+    """
+    V, F = as_mesh(V, F)
+    N = face_cross(V, F)
+    length = np.linalg.norm(N, axis=1, keepdims=True)
+    return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
+
+
+def surface_area(V, F):
+    """Total area of the triangles (length^2)."""
+    return float(face_areas(V, F).sum())
+
+
+def enclosed_volume(V, F):
+    """Signed enclosed volume ``1/6 sum_f v0 . (v1 x v2)`` (length^3), by the divergence theorem.
+
+    Positive for a closed mesh whose faces are counter-clockwise seen from
+    outside; on an open mesh it depends on the origin (not checked here).
+    """
+    V, F = as_mesh(V, F)
+    return float(np.einsum("ij,ij->", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])) / 6.0)
+
+
+def bounding_box_diagonal(V):
+    """Length of the diagonal of the axis-aligned bounding box, ``|max(V) - min(V)|`` (length)."""
+    V = as_vertices(V)
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+def mean_edge_length(V, F):
+    """Mean length of the mesh's edges, each edge counted once (length)."""
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
+    E = edges(F)
+    return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())
