@@ -399,3 +399,8 @@ def _boundary_mask(F, n):
     candidates = (np.bincount(idx, weights=nxt - prv, minlength=n) != 0) | (
         np.bincount(idx, weights=(nxt - prv) * (nxt + prv), minlength=n) != 0)
     return _boundary_counts(F, n, candidates)[0] > 0
+
+
+def angle_deficit(V, F):
+    """(n,) integrated Gaussian curvature 2 pi - sum of the angles at each vertex (interior rule everywhere)."""
+    return gaussian_curvature(V, F, boundary="deficit", integrated=True)

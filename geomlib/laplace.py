@@ -315,3 +315,23 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     C = _cot_matrix(n, F, cot)
     M = sp.diags(_vertex_areas(n, F, l2, dblA, cot, area, degenerate))
     return M, C
+
+
+def uniform_laplacian(V, F):
+    """(M, C) of the uniform Laplacian: C_ij = 1 on edges, C_ii = -valence, M = diag(valence)."""
+    return laplacian(V, F, weights="uniform")
+
+
+def cotangent_matrix(V, F):
+    """C of the cotangent Laplacian: C_ij = (cot alpha_ij + cot beta_ij) / 2, rows summing to zero."""
+    return laplacian(V, F, weights="cotan")[1]
+
+
+def barycentric_areas(V, F):
+    """(n,) vertex areas: a third of the areas of the incident triangles."""
+    return vertex_areas(V, F, area="barycentric")
+
+
+def mixed_areas(V, F):
+    """(n,) mixed Voronoi vertex areas (Meyer et al. 2003)."""
+    return vertex_areas(V, F, area="mixed")

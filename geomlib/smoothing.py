@@ -891,3 +891,13 @@ class _RebuiltStep:
             raise _Collapse(f"the matrix M - step C became singular at iteration {self.k} "
                             f"({exc})") from None
         return Q
+
+
+def explicit_step(P, M, C, tau):
+    """One explicit step P + tau M^-1 C P for (n, 3) positions P."""
+    return P + tau * (C @ P) / M.diagonal()[:, None]
+
+
+def implicit_step(P, M, C, tau):
+    """One implicit step: solve (M - tau C) P' = M P for the (n, 3) positions P'."""
+    return sla.spsolve((M - tau * C).tocsc(), M @ P)
