@@ -1,0 +1,127 @@
+"""geomlib.notebook (show_source, explain, claim, note) and the check vocabulary."""
+
+import numpy as np
+import pytest
+
+import geomlib
+from geomlib import check
+from geomlib.check.result import CheckFailed, Mistake, call, exercise, matrix_pair, use, vector
+from geomlib.notebook import NOTE_PREFIX, ClaimFailed, claim, explain, note, show_source
+
+
+@pytest.fixture
+def shown(monkeypatch):
+    """What the helpers display, as a list of mime bundles."""
+    out = []
+    monkeypatch.setattr("geomlib.notebook._display", out.append)
+    return out
+
+
+def test_show_source_names_the_file_and_lines_and_highlights():
+    src = show_source(geomlib.laplacian)
+    text = repr(src)
+    assert text.startswith("# laplacian — geomlib/laplace.py, lines ")
+    assert "def laplacian(V, F" in text
+    first = int(text.split("lines ")[1].split("–")[0])
+    assert open(geomlib.laplace.__file__).read().splitlines()[first - 1].startswith("def laplacian(")
+    assert "<span" in src._repr_html_() and "geomlib/laplace.py" in src._repr_html_()
+
+
+def test_show_source_of_a_check_shows_its_body_not_the_wrapper():
+    assert "def uniform_laplacian(fn):" in repr(show_source(check.uniform_laplacian))
+
+
+def test_explain_fills_placeholders_into_markdown(shown):
+    explain("""
+        **What happened?** The error is {err:.1%} on {n} vertices.
+        """, err=0.0123, n=42)
+    assert shown == [{"text/markdown": "**What happened?** The error is 1.2% on 42 vertices.",
+                      "text/plain": "**What happened?** The error is 1.2% on 42 vertices."}]
+
+
+def test_claim_that_holds_shows_nothing(shown, monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
+    assert claim(True, "anything") is True and shown == []
+
+
+def test_failed_claim_raises_under_the_strict_tests(monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
+    with pytest.raises(ClaimFailed, match=r"the text says K is within 10 %, but it does not hold: it is 31 %"):
+        claim(False, "K is within 10 %", "it is {e:.0f} %", e=31)
+
+
+def test_failed_claim_is_a_visible_note_for_a_reader(shown, monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+    assert claim(False, "K is within 10 %", "on this mesh it is {e:.0f} % because the grid is coarse", e=31) is False
+    (bundle,) = shown
+    assert bundle["text/plain"] == (f"{NOTE_PREFIX} The text says K is within 10 %. With these inputs it does not "
+                                    "hold: on this mesh it is 31 % because the grid is coarse")
+    assert bundle["text/markdown"].startswith("> **Note.** The text says")
+
+
+def test_note_quotes_every_line(shown):
+    note("first\nsecond")
+    assert shown[0]["text/markdown"] == "> **Note.** first\n> second"
+
+
+# -- the check vocabulary ---------------------------------------------------------------------
+
+@exercise("double", reread="section 1")
+def _check_double(fn):
+    x = vector(call(fn, np.arange(3.0)), 3)
+    if np.allclose(x, np.arange(3.0)):
+        raise Mistake("nothing was doubled", "multiply by 2")
+    if not np.allclose(x, 2 * np.arange(3.0)):
+        raise Mistake("the result is not twice the input")
+    return ["a vector of three numbers"]
+
+
+def test_check_passes_and_says_what_was_checked():
+    r = _check_double(lambda x: 2 * x)
+    assert r.passed and bool(r) and r.message == "checked on a vector of three numbers."
+    assert "passed" in r._repr_html_()
+
+
+def test_check_names_the_mistake_with_hint_and_reread(monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+    r = _check_double(lambda x: x)
+    assert not r.passed and r.message == "nothing was doubled. Hint: multiply by 2. Reread section 1."
+
+
+def test_failed_check_of_a_written_function_raises_under_the_strict_tests(monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
+    with pytest.raises(CheckFailed, match="nothing was doubled"):
+        _check_double(lambda x: x)
+
+
+def test_a_stub_is_not_written_yet_and_never_raises(monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
+
+    def stub(x):
+        raise NotImplementedError("Your turn")
+
+    r = _check_double(stub)
+    assert not r.passed and r.message.startswith("not written yet") and "Reread section 1" in r.message
+
+
+def test_exceptions_and_wrong_shapes_are_diagnosed(monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+    assert "raised ZeroDivisionError" in _check_double(lambda x: 1 / 0).message
+    assert "returned shape (2,)" in _check_double(lambda x: x[:2]).message
+    with pytest.raises(Mistake, match="not the pair"):
+        matrix_pair(np.eye(2), 2)
+
+
+def test_use_falls_back_to_the_reference(capsys, monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+
+    def mine(x):
+        raise NotImplementedError
+
+    def reference(x):
+        return 2 * x
+
+    assert use(mine, _check_double, reference) is reference
+    assert "has not passed its check yet" in capsys.readouterr().out
+    good = lambda x: 2 * x  # noqa: E731
+    assert use(good, _check_double, reference) is good
