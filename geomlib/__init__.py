@@ -29,8 +29,8 @@ _EXPORTS = {
     # input / output and checks
     "load_mesh": "io",
     "save_mesh": "io",
-    "check_mesh": "validate",
-    "MeshReport": "validate",
+    "check_mesh": "report",
+    "MeshReport": "report",
     # topology
     "edges": "topology",
     "boundary_edges": "topology",
@@ -48,7 +48,7 @@ _EXPORTS = {
     "mean_curvature": "curvature",
     "gaussian_curvature": "curvature",
     "principal_curvatures": "curvature",
-    "vertex_normals": "curvature",
+    "vertex_normals": "geometry",
     # spectral
     "eigenbasis": "spectral",
     "spectral_reconstruction": "spectral",

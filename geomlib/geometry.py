@@ -11,7 +11,7 @@ import numpy as np
 from .topology import edges
 from .validate import as_faces, as_mesh, as_vertices
 
-__all__ = ["face_cross", "face_areas", "face_normals", "surface_area", "enclosed_volume",
+__all__ = ["face_cross", "face_areas", "face_normals", "vertex_normals", "surface_area", "enclosed_volume",
            "bounding_box_diagonal", "mean_edge_length"]
 
 
@@ -33,6 +33,19 @@ def face_normals(V, F):
     """
     V, F = as_mesh(V, F)
     N = face_cross(V, F)
+    length = np.linalg.norm(N, axis=1, keepdims=True)
+    return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
+
+
+def vertex_normals(V, F):
+    """(n, 3) float64: area-weighted unit vertex normals, outward for CCW faces.
+
+    The normalised sum of the incident faces' ``2 A_f n_f``. A vertex in no
+    face of non-zero area has no normal: its row is (0, 0, 0), not NaN.
+    """
+    V, F = as_mesh(V, F)
+    N2 = face_cross(V, F)
+    N = np.stack([np.bincount(F.ravel(), np.repeat(N2[:, k], 3), minlength=len(V)) for k in range(3)], axis=1)
     length = np.linalg.norm(N, axis=1, keepdims=True)
     return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
 

@@ -52,7 +52,7 @@ faces, their lines for OBJ/OFF, the bad index and the vertex count), faces
 repeating a vertex (the faces and lines). Properties that do not stop a
 computation (zero-area faces, non-manifold parts, several components,
 unreferenced vertices, ...) are summarised in one :class:`~geomlib.MeshWarning`
-(see :func:`geomlib.validate.check_mesh`); the mesh is returned unaltered.
+(see :func:`geomlib.report.check_mesh`); the mesh is returned unaltered.
 """
 
 from __future__ import annotations
@@ -64,8 +64,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import MeshError, MeshWarning, format_indices
-from .validate import _count, as_mesh, as_vertices, check_mesh
+from .errors import MeshError, MeshWarning, count_text, format_indices
+from .report import check_mesh
+from .validate import as_mesh, as_vertices
 
 __all__ = ["load_mesh", "save_mesh", "SUPPORTED_EXTENSIONS"]
 
@@ -269,7 +270,7 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
     small = np.flatnonzero(sizes < 3)
     if len(small):
         p = small[0]
-        more = f" (and {_count(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})" if len(small) > 1 else ""
+        more = f" (and {count_text(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})" if len(small) > 1 else ""
         raise MeshError(f"{where}: line {lines[p]}: a face needs at least 3 vertex indices, found {sizes[p]}{more}")
     ntri = sizes - 2
     first_tri = np.cumsum(ntri) - ntri  # row in F of each polygon's first triangle
@@ -299,8 +300,8 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
             detail += f" (and {len(corners) - 5} more)"
         valid = f"1..{n}, or -1..-{n} counting back" if one_based else f"0..{n - 1}"
         raise MeshError(
-            f"{where}: face indices out of range, the file has {_count(range(n), 'vertex', 'vertices')} "
-            f"(valid: {valid}): {detail}; {_count(bad_polys, 'face')} on "
+            f"{where}: face indices out of range, the file has {count_text(range(n), 'vertex', 'vertices')} "
+            f"(valid: {valid}): {detail}; {count_text(bad_polys, 'face')} on "
             f"line{'s' if len(bad_polys) > 1 else ''} {format_indices(lines[bad_polys])}"
         )
     if (sizes == 3).all():
@@ -319,7 +320,7 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
         tail = (f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}"
                 if len(rows) > 1 else "")
         raise MeshError(
-            f"{where}: {_count(rows, 'face repeats', 'faces repeat')} a vertex (no triangle; 0-based vertex "
+            f"{where}: {count_text(rows, 'face repeats', 'faces repeat')} a vertex (no triangle; 0-based vertex "
             f"indices): {detail}{tail}"
         )
     return np.ascontiguousarray(F, dtype=np.int64)
@@ -356,7 +357,7 @@ def _check_vertices(V, where, lines_of=None):
         bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
         at = f"; lines {format_indices(lines_of[bad])}" if lines_of is not None else ""
         raise MeshError(
-            f"{where}: {_count(bad, 'vertex has', 'vertices have')} NaN or infinite coordinates: "
+            f"{where}: {count_text(bad, 'vertex has', 'vertices have')} NaN or infinite coordinates: "
             f"vertices {format_indices(bad)} (0-based{at})"
         )
     return as_vertices(V, where=where)
@@ -402,7 +403,7 @@ def _read_off(data, where):
     if len(vlines) < nv or len(flines) < nf:
         raise MeshError(
             f"{where}: the header (line {lineno}) announces {nv} vertices and {nf} faces, but the file ends "
-            f"after {_count(vlines, 'vertex line')} and {_count(flines, 'face line')}"
+            f"after {count_text(vlines, 'vertex line')} and {count_text(flines, 'face line')}"
         )
     _no_mesh_check(where, nv, nf)
     V = np.empty((nv, 3))
