@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import MeshError, MeshWarning, format_indices
-from .geometry import face_cross
+from .geometry import corner_positions, cross
 from .topology import edges
 from .validate import as_mesh, is_zero_area
 
@@ -75,14 +75,16 @@ def face_geometry(V, F):
         Zero-area faces (:func:`geomlib.validate.is_zero_area`).
     """
     V, F = as_mesh(V, F)
-    P = V[F]                                   # (m, 3 corners, 3 coordinates)
-    e = P[:, PREV] - P[:, NEXT]                # e_i = v_k - v_j, opposite corner i
-    l2 = np.einsum("fij,fij->fi", e, e)
-    dblA = np.linalg.norm(face_cross(V, F), axis=1)
-    degenerate = is_zero_area(dblA, l2.max(axis=1))
-    cot = (l2.sum(axis=1, keepdims=True) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))[:, None]
-    cot[degenerate] = 0.0
-    return l2, dblA, cot, degenerate
+    v0, v1, v2 = corner_positions(V, F)            # (3, m) coordinate rows of each corner
+    e = (v2 - v1, v0 - v2, v1 - v0)                # e_i = v_k - v_j, the edge opposite corner i
+    l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])   # |e_i|^2, (3, m)
+    N2 = cross(e[1], e[2])                         # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
+    dblA = np.sqrt(np.einsum("cf,cf->f", N2, N2))
+    degenerate = is_zero_area(dblA, l2.max(axis=0))
+    cot = (l2.sum(axis=0) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))
+    cot[:, degenerate] = 0.0
+    # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
+    return l2.T, dblA, cot.T, degenerate
 
 
 def warn_zero_area(degenerate):
@@ -134,7 +136,8 @@ def cotangent_matrix(V, F):
     w = 0.5 * cot.T.ravel()                                                     # ... gets cot theta_i / 2
     diagonal = -(np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n))  # rows sum to zero
     ii = np.arange(n, dtype=index)
-    return sp.coo_matrix((np.r_[w, w, diagonal], (np.r_[i, j, ii], np.r_[j, i, ii])), shape=(n, n)).tocsr()
+    rows, cols = np.concatenate([i, j, ii]), np.concatenate([j, i, ii])
+    return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
 
 
 def barycentric_areas(V, F):
