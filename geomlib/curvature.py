@@ -127,17 +127,19 @@ def corner_angles(V, F):
     every triangle sum to pi.
     """
     l2, dblA, _, degenerate = face_geometry(V, F)
-    theta = np.arctan2(dblA[:, None], 0.5 * l2.sum(axis=1, keepdims=True) - l2)
+    l2 = l2.T                                                  # (3, m): one row per corner
+    theta = np.arctan2(dblA, 0.5 * l2.sum(axis=0) - l2)
     flat = np.flatnonzero(degenerate)
-    theta[flat] = 0.0
-    theta[flat, np.argmax(l2[flat], axis=1)] = np.pi
-    return theta
+    theta[:, flat] = 0.0
+    theta[np.argmax(l2[:, flat], axis=0), flat] = np.pi
+    return theta.T
 
 
 def angle_sums(V, F):
     """Sum of the triangle angles at each vertex (n,) float64, radians; 0 at unreferenced vertices."""
     V, F = as_mesh(V, F)
-    return np.bincount(F.ravel(), corner_angles(V, F).ravel(), minlength=len(V))
+    theta = corner_angles(V, F)
+    return np.bincount(F.T.ravel(), theta.T.ravel(), minlength=len(V))  # corner by corner: rows are contiguous
 
 
 def angle_deficit(V, F):

@@ -150,7 +150,7 @@ def barycentric_areas(V, F):
     _, dblA, _, degenerate = face_geometry(V, F)
     warn_zero_area(degenerate)
     third = np.where(degenerate, 0.0, dblA / 6.0)
-    return np.bincount(F.ravel(), np.repeat(third, 3), minlength=len(V))
+    return np.bincount(F.T.ravel(), np.tile(third, 3), minlength=len(V))
 
 
 def mixed_areas(V, F):
@@ -175,7 +175,7 @@ def mixed_areas(V, F):
     obtuse_triangle = obtuse.any(axis=1, keepdims=True)
     per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
     per_corner[degenerate] = 0.0
-    return np.bincount(F.ravel(), per_corner.ravel(), minlength=len(V))
+    return np.bincount(F.T.ravel(), per_corner.T.ravel(), minlength=len(V))
 
 
 def vertex_areas(V, F, area="barycentric"):
