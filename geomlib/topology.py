@@ -112,6 +112,17 @@ class Topology:
         same = self.I[h1] == self.I[h2]
         return self.E[np.flatnonzero(self.edge_face_count == 2)[same]]
 
+    def face_pairs(self):
+        """Edges of exactly two faces that traverse them in opposite directions.
+
+        Returns ``E`` (k, 2), each edge ``(i, j)`` as face ``f1`` traverses
+        it, and ``f1``, ``f2`` (k,): the faces holding ``i -> j`` and ``j -> i``.
+        """
+        _, h1, h2 = self._pairs()
+        opposite = self.I[h1] == self.J[h2]
+        h1, h2 = h1[opposite], h2[opposite]
+        return np.stack([self.I[h1], self.J[h1]], axis=1), h1 // 3, h2 // 3
+
     def non_manifold_vertices(self):
         """Vertices whose faces form more than one fan, sorted.
 
