@@ -9,20 +9,22 @@ per-vertex arrays that must line up with the file.)
 
 Format notes
 ------------
-OBJ (read by this module's own parser)
-    ``v x y z`` (an optional ``w`` or ``r g b`` after the coordinates is
-    ignored); faces ``f v``, ``f v/vt``, ``f v//vn``, ``f v/vt/vn`` with
-    1-based or negative (relative: -1 is the latest vertex defined above the
-    face) indices. Only the vertex index of each corner is used: ``vn`` and
-    ``vt`` lines are skipped without being read, so normals and texture
+OBJ (read by this module's own parser, vectorised over lines)
+    Files as real tools write them: a UTF-8 byte-order mark, CRLF or CR line
+    ends, ``v x y z`` with an optional ``w`` or vertex colour ``r g b`` after
+    the coordinates (ignored); faces ``f v``, ``f v/vt``, ``f v//vn``,
+    ``f v/vt/vn`` with 1-based or negative (relative: -1 is the latest vertex
+    defined above the face) indices. Only the vertex index of each corner is
+    used: ``vn`` and ``vt`` lines are skipped, so normals and texture
     coordinates never split a vertex. A polygon with k > 3 corners
     ``(p0, p1, ..., pk-1)`` is triangulated as the fan
     ``(p0, p1, p2), (p0, p2, p3), ..., (p0, pk-2, pk-1)``, which keeps the
-    polygon's orientation (exact for convex planar polygons). Comments (``#``),
-    blank lines and the statements ``o g s usemtl mtllib l p vp`` and the
-    free-form geometry statements are ignored; a line continued with a
-    trailing backslash is joined to the next. Any other line is an error
-    naming its line number.
+    polygon's orientation (exact for convex planar polygons). Comments (``#``,
+    also after a statement), blank lines, groups, objects, materials and
+    smoothing groups (``g o usemtl mtllib s``), points ``p`` and the free-form
+    geometry statements are ignored; line elements ``l`` are ignored and
+    counted in the load warning; a line continued with a trailing backslash
+    is joined to the next. Any other line is an error naming its line number.
 OFF (own parser)
     Optional ``OFF``/``COFF``/``NOFF``/``CNOFF`` header (counts on the same or
     the next line), ``#`` comments, vertex lines (extra numbers after x y z
