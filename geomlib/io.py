@@ -125,22 +125,26 @@ def _obj_lines(data):
         data += b"\n"
     arr = np.frombuffer(data, np.uint8)
     starts, ends = _line_bounds(data)
-    special = np.isin(arr[starts], (32, 9))                        # leading blanks
-    special[np.searchsorted(ends, np.flatnonzero(arr == ord("#")))] = True  # a comment
+    special = np.isin(arr[starts], (32, 9))                                  # leading blanks
+    special[np.searchsorted(ends, np.flatnonzero(arr == ord("#")))] = True      # a comment ...
+    special &= arr[starts] != ord("#")                                          # ... after a statement
     special |= (ends > starts) & (arr[np.maximum(ends - 1, 0)] == ord("\\"))  # a continuation
     if not special.any():
         return data
-    lines = data.split(b"\n")[:-1]
-    for k in np.flatnonzero(special).tolist():
-        lines[k] = lines[k].split(b"#", 1)[0].strip()
+    text = {k: data[starts[k]:ends[k]].split(b"#", 1)[0].strip() for k in np.flatnonzero(special).tolist()}
     # a trailing backslash (outside a comment) continues the statement on the next line: the
     # joined statement keeps the number of its first line, and the continued line becomes blank
-    for k in np.flatnonzero(special).tolist():
-        while lines[k].endswith(b"\\") and k + 1 < len(lines):
-            lines[k] = lines[k][:-1] + b" " + lines[k + 1].split(b"#", 1)[0].strip()
-            lines[k + 1] = b""
-        lines[k] = lines[k].rstrip(b"\\")
-    return b"\n".join(lines) + b"\n"
+    for k in sorted(text):
+        while text[k].endswith(b"\\") and k + 1 < len(starts):
+            following = text.get(k + 1, data[starts[k + 1]:ends[k + 1]])
+            text[k] = text[k][:-1] + b" " + following.split(b"#", 1)[0].strip()
+            text[k + 1] = b""
+        text[k] = text[k].rstrip(b"\\")
+    pieces, pos = [], 0
+    for k in sorted(text):
+        pieces += [data[pos:starts[k]], text[k]]
+        pos = ends[k]
+    return b"".join(pieces) + data[pos:]
 
 
 def _obj_statements(data, starts, ends, where):
