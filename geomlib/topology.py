@@ -263,8 +263,7 @@ def edges(F):
     -------
     E : (e, 2) int64
     """
-    F = as_faces(F)
-    return Topology(F, _nverts(F, None)).E
+    return edge_face_counts(F)[0]
 
 
 def boundary_edges(F):
@@ -305,9 +304,7 @@ def boundary_vertices(F, n=None):
     -------
     (k,) int64
     """
-    F = as_faces(F, n)
-    B = Topology(F, _nverts(F, n)).boundary_edges()
-    return np.unique(B)
+    return np.flatnonzero(boundary_edge_counts(F, n))
 
 
 def loops_from_edges(B):
@@ -423,8 +420,7 @@ def valence(F, n=None):
     """
     F = as_faces(F, n)
     n = _nverts(F, n)
-    E = Topology(F, n).E
-    return np.bincount(E.ravel(), minlength=n).astype(np.int64)
+    return np.bincount(edges(F).ravel(), minlength=n).astype(np.int64)
 
 
 def one_ring(F, i):
