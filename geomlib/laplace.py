@@ -132,11 +132,11 @@ def cotangent_matrix(V, F):
     _, _, cot, degenerate = face_geometry(V, F)
     warn_zero_area(degenerate)
     index = np.int32 if n < 2**31 - 1 else np.int64
-    i, j = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)   # edge (j, k) ...
-    w = 0.5 * cot.T.ravel()                                                     # ... gets cot theta_i / 2
-    diagonal = -(np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n))  # rows sum to zero
-    ii = np.arange(n, dtype=index)
-    rows, cols = np.concatenate([i, j, ii]), np.concatenate([j, i, ii])
+    j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
+    w = 0.5 * cot.T.ravel()                                                        # gets 1/2 cot theta_i
+    diagonal = -(np.bincount(j, w, minlength=n) + np.bincount(k, w, minlength=n))  # rows sum to zero
+    d = np.arange(n, dtype=index)
+    rows, cols = np.concatenate([j, k, d]), np.concatenate([k, j, d])
     return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
 
 
