@@ -30,9 +30,9 @@ import trimesh
 
 import geomlib
 from geomlib.errors import MeshWarning
-from geomlib.metrics import (SCHEMES, SWEEP_ITERATIONS, EXPLICIT_FRACTIONS, IMPLICIT_STEPS, MeshComparison,
-                             denoising_metrics, point_surface_distance, sample_surface, scale_free_step,
-                             smoothing_sweep)
+from geomlib.metrics import MeshComparison, denoising_metrics, point_surface_distance, sample_surface
+from geomlib.sweep import (EXPLICIT_FRACTIONS, IMPLICIT_STEPS, SCHEMES, SWEEP_ITERATIONS, scale_free_step,
+                           smoothing_sweep)
 
 SIGMAS = (0.001, 0.002, 0.005, 0.01, 0.02)
 SEED = 7

@@ -29,8 +29,8 @@ _EXPORTS = {
     # input / output and checks
     "load_mesh": "io",
     "save_mesh": "io",
-    "check_mesh": "validate",
-    "MeshReport": "validate",
+    "check_mesh": "report",
+    "MeshReport": "report",
     # topology
     "edges": "topology",
     "boundary_edges": "topology",
@@ -48,7 +48,7 @@ _EXPORTS = {
     "mean_curvature": "curvature",
     "gaussian_curvature": "curvature",
     "principal_curvatures": "curvature",
-    "vertex_normals": "curvature",
+    "vertex_normals": "geometry",
     # spectral
     "eigenbasis": "spectral",
     "spectral_reconstruction": "spectral",
@@ -64,7 +64,7 @@ _EXPORTS = {
     "ImplicitSmoother": "smoothing",
     # noise and evaluation
     "add_noise": "noise",
-    "bounding_box_diagonal": "metrics",
+    "bounding_box_diagonal": "geometry",
     "vertex_rms": "metrics",
     "hausdorff_distance": "metrics",
     "face_normal_angles": "metrics",
@@ -77,7 +77,7 @@ _EXPORTS = {
     "denoising_metrics": "metrics",
     "MeshComparison": "metrics",
     "point_surface_distance": "metrics",
-    "smoothing_sweep": "metrics",
+    "smoothing_sweep": "sweep",
 }
 
 __all__ = sorted(["MeshError", "MeshWarning", "data_path", *_EXPORTS])
@@ -104,7 +104,7 @@ def __getattr__(name):
         value = getattr(import_module(f".{_EXPORTS[name]}", __name__), name)
         globals()[name] = value
         return value
-    if name in ("symbolic", "surfaces", "viewer", "metrics"):
+    if name in ("symbolic", "surfaces", "viewer", "metrics", "sweep"):
         return import_module(f".{name}", __name__)
     raise AttributeError(f"module 'geomlib' has no attribute {name!r}")
 

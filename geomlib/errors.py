@@ -28,3 +28,9 @@ def format_indices(idx, limit=10):
     if len(idx) > limit:
         head += f" (and {len(idx) - limit} more)"
     return head
+
+
+def count_text(items, singular, plural=None):
+    """'1 edge', '3 edges': the number of ``items`` with its noun in the right number."""
+    k = len(items)
+    return f"{k} {singular if k == 1 else (plural or singular + 's')}"

@@ -11,13 +11,28 @@ import numpy as np
 from .topology import edges
 from .validate import as_faces, as_mesh, as_vertices
 
-__all__ = ["face_cross", "face_areas", "face_normals", "surface_area", "enclosed_volume",
+__all__ = ["corner_positions", "cross", "face_cross", "face_areas", "face_normals", "vertex_normals", "surface_area", "enclosed_volume",
            "bounding_box_diagonal", "mean_edge_length"]
+
+
+def corner_positions(V, F):
+    """(3, 3, m) float64: ``P[i]`` holds the (x, y, z) rows of corner i of every face (unchecked input).
+
+    Corner-major, coordinate rows: each row is contiguous, which makes the
+    per-face formulas below and in geomlib.laplace fast.
+    """
+    return np.ascontiguousarray(V.T).take(F.T, axis=1).swapaxes(0, 1)
+
+
+def cross(a, b):
+    """Cross product of (3, m) coordinate rows, written out (several times faster than ``np.cross``)."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def face_cross(V, F):
     """(m, 3) float64: ``(v1 - v0) x (v2 - v0)`` per face, which is 2 A_f n_f (unchecked input)."""
-    return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    v0, v1, v2 = corner_positions(V, F)
+    return cross(v1 - v0, v2 - v0).T
 
 
 def face_areas(V, F):
@@ -33,6 +48,19 @@ def face_normals(V, F):
     """
     V, F = as_mesh(V, F)
     N = face_cross(V, F)
+    length = np.linalg.norm(N, axis=1, keepdims=True)
+    return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
+
+
+def vertex_normals(V, F):
+    """(n, 3) float64: area-weighted unit vertex normals, outward for CCW faces.
+
+    The normalised sum of the incident faces' ``2 A_f n_f``. A vertex in no
+    face of non-zero area has no normal: its row is (0, 0, 0), not NaN.
+    """
+    V, F = as_mesh(V, F)
+    N2 = face_cross(V, F)
+    N = np.stack([np.bincount(F.ravel(), np.repeat(N2[:, k], 3), minlength=len(V)) for k in range(3)], axis=1)
     length = np.linalg.norm(N, axis=1, keepdims=True)
     return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
 

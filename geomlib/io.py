@@ -9,20 +9,22 @@ per-vertex arrays that must line up with the file.)
 
 Format notes
 ------------
-OBJ (read by this module's own parser)
-    ``v x y z`` (an optional ``w`` or ``r g b`` after the coordinates is
-    ignored); faces ``f v``, ``f v/vt``, ``f v//vn``, ``f v/vt/vn`` with
-    1-based or negative (relative: -1 is the latest vertex defined above the
-    face) indices. Only the vertex index of each corner is used: ``vn`` and
-    ``vt`` lines are skipped without being read, so normals and texture
+OBJ (read by this module's own parser, vectorised over lines)
+    Files as real tools write them: a UTF-8 byte-order mark, CRLF or CR line
+    ends, ``v x y z`` with an optional ``w`` or vertex colour ``r g b`` after
+    the coordinates (ignored); faces ``f v``, ``f v/vt``, ``f v//vn``,
+    ``f v/vt/vn`` with 1-based or negative (relative: -1 is the latest vertex
+    defined above the face) indices. Only the vertex index of each corner is
+    used: ``vn`` and ``vt`` lines are skipped, so normals and texture
     coordinates never split a vertex. A polygon with k > 3 corners
     ``(p0, p1, ..., pk-1)`` is triangulated as the fan
     ``(p0, p1, p2), (p0, p2, p3), ..., (p0, pk-2, pk-1)``, which keeps the
-    polygon's orientation (exact for convex planar polygons). Comments (``#``),
-    blank lines and the statements ``o g s usemtl mtllib l p vp`` and the
-    free-form geometry statements are ignored; a line continued with a
-    trailing backslash is joined to the next. Any other line is an error
-    naming its line number.
+    polygon's orientation (exact for convex planar polygons). Comments (``#``,
+    also after a statement), blank lines, groups, objects, materials and
+    smoothing groups (``g o usemtl mtllib s``), points ``p`` and the free-form
+    geometry statements are ignored; line elements ``l`` are ignored and
+    counted in the load warning; a line continued with a trailing backslash
+    is joined to the next. Any other line is an error naming its line number.
 OFF (own parser)
     Optional ``OFF``/``COFF``/``NOFF``/``CNOFF`` header (counts on the same or
     the next line), ``#`` comments, vertex lines (extra numbers after x y z
@@ -52,7 +54,7 @@ faces, their lines for OBJ/OFF, the bad index and the vertex count), faces
 repeating a vertex (the faces and lines). Properties that do not stop a
 computation (zero-area faces, non-manifold parts, several components,
 unreferenced vertices, ...) are summarised in one :class:`~geomlib.MeshWarning`
-(see :func:`geomlib.validate.check_mesh`); the mesh is returned unaltered.
+(see :func:`geomlib.report.check_mesh`); the mesh is returned unaltered.
 """
 
 from __future__ import annotations
@@ -64,8 +66,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import MeshError, MeshWarning, format_indices
-from .validate import _count, as_mesh, as_vertices, check_mesh
+from .errors import MeshError, MeshWarning, count_text, format_indices
+from .report import check_mesh
+from .validate import as_mesh, as_vertices
 
 __all__ = ["load_mesh", "save_mesh", "SUPPORTED_EXTENSIONS"]
 
@@ -83,174 +86,169 @@ _OBJ_IGNORED = {
 _HUGE = 2**62  # larger indices cannot be a vertex of any file (and would overflow int64)
 
 
-class _Fallback(Exception):
-    """The vectorised OBJ reader met something unusual; reread line by line."""
-
-
 def _show(line, limit=60):
     text = line.decode("utf-8", "replace").strip()
     return repr(text if len(text) <= limit else text[:limit] + "...")
 
 
 # --------------------------------------------------------------------------
-# OBJ, vectorised path
+# OBJ: one reader, vectorised over lines
+#
+# 1. _obj_lines: bytes -> one statement per line, with the file's line numbers
+#    kept (byte-order mark and CR line ends removed; comments, continuation
+#    backslashes and leading blanks resolved in Python, only on the few lines
+#    that have them).
+# 2. _obj_statements: the keyword of every line (vectorised on its first bytes).
+# 3. _obj_numbers: the numbers of all v lines, then of all f lines, each with one
+#    np.fromstring call; when that fails, _obj_bad_line names the first bad line.
 
 
-def _select_lines(data, arr, starts, ends, idx):
-    """Bytes of the lines ``idx`` (each with its newline), concatenated."""
+_BOM = b"\xef\xbb\xbf"
+
+
+def _line_bounds(data):
+    """Start and end (the index of its newline) of every line of ``data`` (which ends with a newline)."""
+    ends = np.flatnonzero(np.frombuffer(data, np.uint8) == 10)
+    starts = np.empty_like(ends)
+    starts[:1] = 0
+    starts[1:] = ends[:-1] + 1
+    return starts, ends
+
+
+def _obj_lines(data):
+    """The file as newline-terminated statements, line k of the result being line k + 1 of the file."""
+    if data.startswith(_BOM):  # written by many Windows programs
+        data = data[len(_BOM):]
+    if b"\r" in data:  # CRLF (Windows) or CR (classic Mac OS) line ends
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    if not data.endswith(b"\n"):
+        data += b"\n"
+    arr = np.frombuffer(data, np.uint8)
+    starts, ends = _line_bounds(data)
+    special = np.isin(arr[starts], (32, 9))                                  # leading blanks
+    special[np.searchsorted(ends, np.flatnonzero(arr == ord("#")))] = True      # a comment ...
+    special &= arr[starts] != ord("#")                                          # ... after a statement
+    special |= (ends > starts) & (arr[np.maximum(ends - 1, 0)] == ord("\\"))  # a continuation
+    if not special.any():
+        return data
+    text = {k: data[starts[k]:ends[k]].split(b"#", 1)[0].strip() for k in np.flatnonzero(special).tolist()}
+    # a trailing backslash (outside a comment) continues the statement on the next line: the
+    # joined statement keeps the number of its first line, and the continued line becomes blank
+    for k in sorted(text):
+        while text[k].endswith(b"\\") and k + 1 < len(starts):
+            following = text.get(k + 1, data[starts[k + 1]:ends[k + 1]])
+            text[k] = text[k][:-1] + b" " + following.split(b"#", 1)[0].strip()
+            text[k + 1] = b""
+        text[k] = text[k].rstrip(b"\\")
+    pieces, pos = [], 0
+    for k in sorted(text):
+        pieces += [data[pos:starts[k]], text[k]]
+        pos = ends[k]
+    return b"".join(pieces) + data[pos:]
+
+
+def _obj_statements(data, starts, ends, where):
+    """Boolean masks of the v, f and l lines; MeshError on the first unknown statement."""
+    arr = np.frombuffer(data, np.uint8)
+    last = len(arr) - 1
+    c0, c1, c2 = (arr[np.minimum(starts + k, last)] for k in range(3))
+    ws1 = (c1 == 32) | (c1 == 9)
+    ws2 = (c2 == 32) | (c2 == 9)
+    is_v, is_f, is_l = ((c0 == ord(c)) & ws1 for c in "vfl")
+    known = (is_v | is_f | is_l | (starts == ends) | (c0 == ord("#"))
+             | ((c0 == ord("v")) & np.isin(c1, np.frombuffer(b"ntp", np.uint8)) & ws2)
+             | (np.isin(c0, np.frombuffer(b"ogsp", np.uint8)) & (ws1 | (starts + 1 == ends))))
+    for k in np.flatnonzero(~known).tolist():  # longer keywords (usemtl, mtllib, ...) or an error
+        words = data[starts[k]:ends[k]].split()
+        if words and words[0] not in _OBJ_IGNORED:
+            raise MeshError(f"{where}: line {k + 1}: not an OBJ statement (expected v, f, vn, vt, o, g, s, "
+                            f"usemtl, mtllib or a # comment): {_show(data[starts[k]:ends[k]])}")
+    return is_v, is_f, is_l
+
+
+def _select(data, starts, ends, idx, keyword):
+    """The lines ``idx`` without their keyword, concatenated (each keeps its newline)."""
     if len(idx) == 0:
         return b""
-    breaks = np.flatnonzero(np.diff(idx) != 1)
-    if len(breaks) < 64:  # a few contiguous blocks: plain slices
-        first = np.r_[idx[0], idx[breaks + 1]]
-        last = np.r_[idx[breaks], idx[-1]]
-        return b"".join(data[s:e + 1] for s, e in zip(starts[first].tolist(), ends[last].tolist()))
-    # many interleaved lines (e.g. v / vn alternating): mask of the bytes to keep
-    mark = np.zeros(len(arr) + 1, np.int8)
-    mark[starts[idx]] = 1
-    mark[ends[idx] + 1] -= 1
-    keep = np.cumsum(mark[:-1], dtype=np.int8).view(bool)
-    return arr[keep].tobytes()
+    arr = np.frombuffer(data, np.uint8)
+    keep = np.zeros(len(arr) + 1, np.int8)
+    keep[starts[idx] + len(keyword)] = 1  # from after the keyword ...
+    keep[ends[idx] + 1] -= 1              # ... to the newline included
+    return arr[np.cumsum(keep[:-1], dtype=np.int8).view(bool)].tobytes()
 
 
 def _tokens_per_line(buf):
     """Whitespace-separated tokens on each newline-terminated line of ``buf``."""
     s = np.frombuffer(buf, np.uint8)
-    ws = s <= 32  # space, tab, CR, LF and other control bytes
+    ws = s <= 32
     tok = np.flatnonzero(~ws[1:] & ws[:-1]) + 1
     if len(s) and not ws[0]:
         tok = np.r_[0, tok]
-    nl = np.flatnonzero(s == 10)
-    return np.diff(np.searchsorted(tok, nl), prepend=0)
+    return np.diff(np.searchsorted(tok, np.flatnonzero(s == 10)), prepend=0)
 
 
-def _fromstring(buf, dtype):
+def _numbers(buf, dtype):
+    """All numbers of ``buf`` with one C call; None when a token is not a number."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         try:
             return np.fromstring(buf, sep=" ", dtype=dtype)
         except (ValueError, DeprecationWarning):
-            raise _Fallback from None
+            return None
 
 
-def _obj_fast(data):
-    if b"\\" in data:
-        raise _Fallback
-    arr = np.frombuffer(data, np.uint8)
-    nl = np.flatnonzero(arr == 10)
-    starts = np.empty(len(nl), np.int64)
-    starts[:1] = 0
-    starts[1:] = nl[:-1] + 1
-    ends = nl
-    last = len(arr) - 1
-    c0 = arr[starts]
-    c1 = arr[np.minimum(starts + 1, last)]
-    c2 = arr[np.minimum(starts + 2, last)]
-    ws1 = (c1 == 32) | (c1 == 9)
-    ws2 = (c2 == 32) | (c2 == 9)
-    is_v = (c0 == ord("v")) & ws1
-    is_f = (c0 == ord("f")) & ws1
-    known = (
-        is_v | is_f | (c0 == ord("#")) | (c0 == 10) | ((c0 == 13) & (c1 == 10))
-        | ((c0 == ord("v")) & ((c1 == ord("n")) | (c1 == ord("t")) | (c1 == ord("p"))) & ws2)
-        | (np.isin(c0, np.frombuffer(b"ogslp", np.uint8)) & (ws1 | (c1 == 10) | (c1 == 13)))
-    )
-    for k in np.flatnonzero(~known).tolist():
-        words = data[starts[k]:ends[k]].split()
-        if not words or words[0] in _OBJ_IGNORED or words[0].startswith(b"#"):
-            continue
-        raise _Fallback  # indented v/f, unknown statements, bad bytes: the slow reader decides
-    v_idx = np.flatnonzero(is_v)
-    f_idx = np.flatnonzero(is_f)
+def _obj_bad_line(data, starts, ends, idx, where):
+    """Raise the MeshError naming the first malformed v or f line among ``idx`` (the error path only)."""
+    for k in idx.tolist():
+        raw = data[starts[k]:ends[k]]
+        words = raw.split()
+        if words[0] == b"v":
+            if len(words) - 1 not in (3, 4, 6, 7):
+                raise MeshError(f"{where}: line {k + 1}: a vertex needs x y z (optionally w or r g b), "
+                                f"found {len(words) - 1} numbers: {_show(raw)}")
+            try:
+                [float(w) for w in words[1:]]
+            except ValueError:
+                raise MeshError(f"{where}: line {k + 1}: vertex coordinates are not numbers: {_show(raw)}") from None
+        else:
+            try:
+                corners = [int(c.split(b"/")[0]) for c in words[1:]]
+            except ValueError:
+                raise MeshError(f"{where}: line {k + 1}: face corners must be integers "
+                                f"(v, v/vt, v//vn or v/vt/vn): {_show(raw)}") from None
+            if any(abs(c) > _HUGE for c in corners):
+                raise MeshError(f"{where}: line {k + 1}: face index too large: {_show(raw)}")
+    raise MeshError(f"{where}: cannot read the numbers of the v and f lines")  # not reached for valid bytes
 
-    vbuf = _select_lines(data, arr, starts, ends, v_idx).replace(b"v", b" ")
+
+def _read_obj(data, where):
+    """(V, F, notes) from the bytes of an OBJ file; ``notes`` lists what was ignored."""
+    data = _obj_lines(data)
+    starts, ends = _line_bounds(data)
+    is_v, is_f, is_l = _obj_statements(data, starts, ends, where)
+    v_idx, f_idx = np.flatnonzero(is_v), np.flatnonzero(is_f)
+
+    vbuf = _select(data, starts, ends, v_idx, b"v")
     counts = _tokens_per_line(vbuf)
-    vals = _fromstring(vbuf, np.float64)
-    if len(vals) != counts.sum():
-        raise _Fallback
-    if len(counts) and (counts == 3).all():
-        V = vals.reshape(-1, 3)
-    else:
-        if len(counts) and not np.isin(counts, (3, 4, 6, 7)).all():
-            raise _Fallback
-        offs = np.cumsum(counts) - counts
-        V = vals[offs[:, None] + np.arange(3)]
+    vals = _numbers(vbuf, np.float64)
+    if vals is None or len(vals) != counts.sum() or not np.isin(counts, (3, 4, 6, 7)).all():
+        _obj_bad_line(data, starts, ends, v_idx, where)
+    V = vals.reshape(-1, 3) if (counts == 3).all() else vals[(np.cumsum(counts) - counts)[:, None] + np.arange(3)]
 
-    fbuf = _select_lines(data, arr, starts, ends, f_idx).replace(b"f", b" ")
-    if b"/" in fbuf:
+    fbuf = _select(data, starts, ends, f_idx, b"f")
+    if b"/" in fbuf:  # v/vt/vn corners: only the vertex index is used
         fbuf = re.sub(rb"/\S*", b"", fbuf)
     sizes = _tokens_per_line(fbuf)
-    idx = _fromstring(fbuf, np.int64)
-    if len(idx) != sizes.sum() or (len(idx) and (idx.max() > _HUGE or idx.min() < -_HUGE)):
-        raise _Fallback  # (np.fromstring saturates huge integers instead of failing)
-    lines = f_idx + 1
-    vbefore = None
-    if len(idx) and idx.min() < 0:
-        vbefore = np.searchsorted(v_idx, f_idx)  # v lines above each face line
-    return V, idx, sizes, lines, vbefore, v_idx + 1
+    idx = _numbers(fbuf, np.int64)
+    if idx is None or len(idx) != sizes.sum() or (len(idx) and (idx.max() > _HUGE or idx.min() < -_HUGE)):
+        _obj_bad_line(data, starts, ends, f_idx, where)  # (np.fromstring saturates huge integers)
 
-
-# --------------------------------------------------------------------------
-# OBJ, line by line (odd files, and exact error locations)
-
-
-def _obj_slow(data, where):
-    verts, vlines, idx, sizes, lines, vbefore = [], [], [], [], [], []
-    pending = b""
-    pending_line = 0
-    for lineno, raw in enumerate(data.split(b"\n"), start=1):
-        if pending:
-            raw = pending + b" " + raw
-            lineno = pending_line
-            pending = b""
-        hash_pos = raw.find(b"#")  # a comment runs to the end of the line
-        stripped = (raw[:hash_pos] if hash_pos >= 0 else raw).rstrip()
-        if stripped.endswith(b"\\"):  # continued on the next line
-            pending, pending_line = stripped[:-1], lineno
-            continue
-        words = stripped.split()
-        if not words:
-            continue
-        key = words[0]
-        if key == b"v":
-            if len(words) - 1 not in (3, 4, 6, 7):
-                raise MeshError(
-                    f"{where}: line {lineno}: a vertex needs x y z (optionally w or r g b), "
-                    f"found {len(words) - 1} numbers: {_show(raw)}"
-                )
-            try:
-                verts.append([float(w) for w in words[1:4]])
-                [float(w) for w in words[4:]]
-                vlines.append(lineno)
-            except ValueError:
-                raise MeshError(f"{where}: line {lineno}: vertex coordinates are not numbers: {_show(raw)}") from None
-        elif key == b"f":
-            corners = words[1:]
-            try:
-                face = []
-                for c in corners:
-                    head = c.split(b"/")[0]
-                    face.append(int(head))
-            except ValueError:
-                raise MeshError(
-                    f"{where}: line {lineno}: face corners must be integers (v, v/vt, v//vn or v/vt/vn): {_show(raw)}"
-                ) from None
-            if any(abs(c) > _HUGE for c in face):
-                raise MeshError(f"{where}: line {lineno}: face index too large: {_show(raw)}")
-            idx.extend(face)
-            sizes.append(len(face))
-            lines.append(lineno)
-            vbefore.append(len(verts))
-        elif key in _OBJ_IGNORED:
-            continue
-        else:
-            raise MeshError(
-                f"{where}: line {lineno}: not an OBJ statement (expected v, f, vn, vt, o, g, s, usemtl, "
-                f"mtllib or a # comment): {_show(raw)}"
-            )
-    V = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
-    return (V, np.asarray(idx, np.int64), np.asarray(sizes, np.int64),
-            np.asarray(lines, np.int64), np.asarray(vbefore, np.int64), np.asarray(vlines, np.int64))
+    _no_mesh_check(where, len(V), len(sizes))
+    V = _check_vertices(V, where, lines_of=v_idx + 1)
+    vbefore = np.searchsorted(v_idx, f_idx) if len(idx) and idx.min() < 0 else None  # v lines above each face
+    F = _build_faces(where, len(V), idx, sizes, f_idx + 1, one_based=True, vbefore=vbefore)
+    notes = [f"{count_text(np.flatnonzero(is_l), 'line element')} ('l' statements) ignored"] if is_l.any() else []
+    return V, F, notes
 
 
 # --------------------------------------------------------------------------
@@ -269,7 +267,7 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
     small = np.flatnonzero(sizes < 3)
     if len(small):
         p = small[0]
-        more = f" (and {_count(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})" if len(small) > 1 else ""
+        more = f" (and {count_text(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})" if len(small) > 1 else ""
         raise MeshError(f"{where}: line {lines[p]}: a face needs at least 3 vertex indices, found {sizes[p]}{more}")
     ntri = sizes - 2
     first_tri = np.cumsum(ntri) - ntri  # row in F of each polygon's first triangle
@@ -299,8 +297,8 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
             detail += f" (and {len(corners) - 5} more)"
         valid = f"1..{n}, or -1..-{n} counting back" if one_based else f"0..{n - 1}"
         raise MeshError(
-            f"{where}: face indices out of range, the file has {_count(range(n), 'vertex', 'vertices')} "
-            f"(valid: {valid}): {detail}; {_count(bad_polys, 'face')} on "
+            f"{where}: face indices out of range, the file has {count_text(range(n), 'vertex', 'vertices')} "
+            f"(valid: {valid}): {detail}; {count_text(bad_polys, 'face')} on "
             f"line{'s' if len(bad_polys) > 1 else ''} {format_indices(lines[bad_polys])}"
         )
     if (sizes == 3).all():
@@ -319,25 +317,10 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
         tail = (f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}"
                 if len(rows) > 1 else "")
         raise MeshError(
-            f"{where}: {_count(rows, 'face repeats', 'faces repeat')} a vertex (no triangle; 0-based vertex "
+            f"{where}: {count_text(rows, 'face repeats', 'faces repeat')} a vertex (no triangle; 0-based vertex "
             f"indices): {detail}{tail}"
         )
     return np.ascontiguousarray(F, dtype=np.int64)
-
-
-def _read_obj(data, where):
-    if b"\n" not in data and b"\r" in data:  # classic Mac line ends
-        data = data.replace(b"\r", b"\n")
-    if not data.endswith(b"\n"):
-        data += b"\n"
-    try:
-        V, idx, sizes, lines, vbefore, vlines = _obj_fast(data)
-    except _Fallback:
-        V, idx, sizes, lines, vbefore, vlines = _obj_slow(data, where)
-    _no_mesh_check(where, len(V), len(sizes))
-    V = _check_vertices(V, where, lines_of=vlines)
-    F = _build_faces(where, len(V), idx, sizes, lines, one_based=True, vbefore=vbefore)
-    return V, F
 
 
 def _no_mesh_check(where, nv, nf):
@@ -356,7 +339,7 @@ def _check_vertices(V, where, lines_of=None):
         bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
         at = f"; lines {format_indices(lines_of[bad])}" if lines_of is not None else ""
         raise MeshError(
-            f"{where}: {_count(bad, 'vertex has', 'vertices have')} NaN or infinite coordinates: "
+            f"{where}: {count_text(bad, 'vertex has', 'vertices have')} NaN or infinite coordinates: "
             f"vertices {format_indices(bad)} (0-based{at})"
         )
     return as_vertices(V, where=where)
@@ -402,7 +385,7 @@ def _read_off(data, where):
     if len(vlines) < nv or len(flines) < nf:
         raise MeshError(
             f"{where}: the header (line {lineno}) announces {nv} vertices and {nf} faces, but the file ends "
-            f"after {_count(vlines, 'vertex line')} and {_count(flines, 'face line')}"
+            f"after {count_text(vlines, 'vertex line')} and {count_text(flines, 'face line')}"
         )
     _no_mesh_check(where, nv, nf)
     V = np.empty((nv, 3))
@@ -526,8 +509,9 @@ def load_mesh(path, report=False):
         raise MeshError(f"{where}: cannot read the file: {exc.strerror or exc}") from None
     if not data or data.isspace():  # isspace stops at the first other byte
         raise MeshError(f"{where}: the file is empty")
+    notes = []
     if ext == ".obj":
-        V, F = _read_obj(data, where)
+        V, F, notes = _read_obj(data, where)
     elif ext == ".off":
         V, F = _read_off(data, where)
     else:
@@ -535,8 +519,8 @@ def load_mesh(path, report=False):
     rep = check_mesh(V, F)
     if report:
         return V, F, rep
-    if not rep.ok:
-        warnings.warn(MeshWarning(f"{where}: {rep.summary()}"), stacklevel=2)
+    if not rep.ok or notes:
+        warnings.warn(MeshWarning(f"{where}: {'; '.join(rep.problems + notes)}"), stacklevel=2)
     return V, F
 
 

@@ -1,35 +1,31 @@
-"""Discrete Laplace-Beltrami operators: Delta = M^-1 C, C symmetric negative semidefinite.
+"""Lesson (notebooks 01 and 03): the discrete Laplace-Beltrami operator Delta = M^-1 C.
 
-Convention used everywhere in geomlib (the course's notation and sign):
+The convention of the whole workbook:
 
 * ``C`` is symmetric, negative semidefinite, its rows sum to zero. Off the
   diagonal ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)`` for the cotangent
   operator (Pinkall and Polthier 1993; Meyer et al. 2003) and ``C_ij = 1`` for
   the uniform (graph) operator, for every edge ij; ``C_ii = -sum_j C_ij``.
-* ``M`` is diagonal: the vertex area for the cotangent operator (a third of the
-  incident triangle areas for ``area="barycentric"``, the mixed Voronoi area of
-  Meyer et al. 2003 for ``area="mixed"``), and the valence (number of
-  neighbours) for the uniform operator.
-* ``Delta = M^-1 C`` so that ``Delta x = -2 H n`` with ``n`` the outward unit
+* ``M`` is diagonal: the vertex area ``A_i`` for the cotangent operator (a
+  third of the incident triangle areas, or the mixed Voronoi area of Meyer et
+  al. 2003) and the valence for the uniform operator.
+* ``Delta = M^-1 C``, so that ``Delta x = -2 H n`` with ``n`` the outward unit
   normal and ``H > 0`` on a sphere.
 
 Policy for bad triangles (never a NaN or an infinity in ``M`` or ``C``):
 
-* Zero-area triangles (``2 area <= ZERO_AREA_RTOL * longest edge^2``, the same
-  scale-free test as :func:`geomlib.validate.check_mesh`) have no defined
-  angles. They contribute nothing to the cotangent ``C`` or to ``M`` and a
-  :class:`~geomlib.errors.MeshWarning` names them. The uniform operator is
-  combinatorial: their edges still count there.
-* Needle triangles (small but non-zero area) keep their exact cotangents. Those
-  are large (bounded by ``1 / ZERO_AREA_RTOL``) but finite, and ``C`` stays
-  symmetric and negative semidefinite (it is a sum of per-triangle negative
-  semidefinite matrices); clamping them would break the exactness of ``C`` on
-  linear functions over flat regions, so it is not done.
-* A vertex in no triangle of non-zero area (an isolated vertex) has a zero row
-  in ``C`` and a zero in ``M``: ``Delta`` is undefined there, and functions
-  that divide by ``M`` say so (NaN with a MeshWarning naming the vertices).
-* Non-manifold edges (three or more triangles) receive the sum of all their
-  opposite cotangents: still the sum of per-triangle operators.
+* Zero-area triangles (``2 A <= ZERO_AREA_RTOL * longest edge^2``, the test of
+  :func:`geomlib.validate.is_zero_area`) have no angles. They add nothing to
+  the cotangent ``C`` or to ``M``, and a :class:`~geomlib.errors.MeshWarning`
+  names them. The uniform operator is combinatorial: their edges still count.
+* Needle triangles (small but non-zero area) keep their exact cotangents:
+  large (at most ``1 / ZERO_AREA_RTOL``) but finite. Clamping them would break
+  ``C x = 0`` for linear functions on flat regions.
+* A vertex in no triangle of non-zero area has a zero row in ``C`` and a zero
+  in ``M``: ``Delta`` is undefined there, and the functions that divide by
+  ``M`` say so.
+* A non-manifold edge (three or more triangles) gets the sum of all its
+  opposite cotangents: ``C`` stays a sum of per-triangle NSD matrices.
 """
 
 import warnings
@@ -38,235 +34,162 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import MeshError, MeshWarning, format_indices
+from .geometry import corner_positions, cross
+from .topology import edges
+from .validate import as_mesh, is_zero_area
 
-try:  # one definition of "zero area" for the whole package
-    from .validate import ZERO_AREA_RTOL
-except ImportError:  # pragma: no cover - validation module not yet available
-    ZERO_AREA_RTOL = 1e-12
-
-#: Kept for backward compatibility: the zero-area threshold (see module docstring).
-DEGENERATE_REL_AREA = ZERO_AREA_RTOL
+__all__ = ["laplacian", "uniform_laplacian", "cotangent_matrix", "cotangent_weights", "vertex_areas",
+           "barycentric_areas", "mixed_areas", "face_geometry", "uniform_adjacency", "WEIGHTS", "AREAS"]
 
 WEIGHTS = ("cotan", "uniform")
 AREAS = ("barycentric", "mixed")
 
-
-def _as_mesh(V, F):
-    """Validate and coerce (V, F) with geomlib.validate.as_mesh (MeshError on bad input)."""
-    try:
-        from .validate import as_mesh
-    except ImportError:  # pragma: no cover - validation module not yet available
-        V = np.ascontiguousarray(V, dtype=np.float64)
-        F = np.ascontiguousarray(F, dtype=np.int64)
-        if V.ndim != 2 or V.shape[1] != 3:
-            raise MeshError(f"V must have shape (n, 3), not {V.shape}")
-        if F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
-            raise MeshError(f"F must have shape (m, 3) with m > 0, not {F.shape}")
-        bad = np.flatnonzero(((F < 0) | (F >= len(V))).any(axis=1))
-        if len(bad):
-            raise MeshError(f"face indices out of range 0..{len(V) - 1} in faces {format_indices(bad)}")
-        return V, F
-    return as_mesh(V, F)
+# the corners (j, k) that follow corner i = 0, 1, 2 counter-clockwise
+NEXT, PREV = [1, 2, 0], [2, 0, 1]
 
 
-def _check_options(weights=None, area=None):
+def check_options(weights=None, area=None):
+    """Raise MeshError for a ``weights`` or ``area`` that geomlib does not know."""
     if weights is not None and weights not in WEIGHTS:
         raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
     if area is not None and area not in AREAS:
         raise MeshError(f"area must be 'barycentric' or 'mixed', not {area!r}")
 
 
-def _geometry(V, F, columns=None, with_cot=True):
-    """Face geometry in (3, m) layout (one row per corner): l2, dblA, cot, degenerate.
-
-    Computed coordinate by coordinate on contiguous arrays (no np.cross, no
-    (m, 3) temporaries), which is what makes the assembly as fast as libigl's.
-    ``columns`` = (X, Y, Z) coordinate arrays (views are fine) when the caller
-    processes the faces block by block and wants to avoid a copy per block.
-    """
-    X, Y, Z = np.ascontiguousarray(V.T) if columns is None else columns
-    i0, i1, i2 = np.ascontiguousarray(F.T)
-    x0, x1, x2 = X[i0], X[i1], X[i2]
-    y0, y1, y2 = Y[i0], Y[i1], Y[i2]
-    z0, z1, z2 = Z[i0], Z[i1], Z[i2]
-    # edge vectors opposite corners 0, 1, 2
-    ax, ay, az = x2 - x1, y2 - y1, z2 - z1
-    bx, by, bz = x0 - x2, y0 - y2, z0 - z2
-    cx, cy, cz = x1 - x0, y1 - y0, z1 - z0
-    m = len(F)
-    l2 = np.empty((3, m))
-    l2[0] = ax * ax + ay * ay + az * az
-    l2[1] = bx * bx + by * by + bz * bz
-    l2[2] = cx * cx + cy * cy + cz * cz
-    # twice the area: |(P1 - P0) x (P2 - P0)| = |c x (-b)|
-    nx = bz * cy - by * cz
-    ny = bx * cz - bz * cx
-    nz = by * cx - bx * cy
-    dblA = np.sqrt(nx * nx + ny * ny + nz * nz)
-    degenerate = dblA <= ZERO_AREA_RTOL * l2.max(axis=0)
-    if not with_cot:  # callers that need only lengths and areas (angle sums, barycentric areas)
-        return l2, dblA, None, degenerate
-    # cot(angle at i) = <e_j, e_k> / |e_j x e_k| = (l_j^2 + l_k^2 - l_i^2) / (2 * 2A)
-    denom = 2.0 * np.where(degenerate, 1.0, dblA)
-    s = l2.sum(axis=0)
-    cot = (s - 2.0 * l2) / denom
-    cot[:, degenerate] = 0.0
-    return l2, dblA, cot, degenerate
-
-
 def face_geometry(V, F):
-    """Per-face squared edge lengths, doubled areas and corner cotangents.
+    """Per face: squared edge lengths, twice the area, corner cotangents, zero-area flag.
 
-    Parameters
-    ----------
-    V : (n, 3) float64
-    F : (m, 3) int64
+    Corner ``i`` of face ``(v0, v1, v2)`` sits opposite the edge ``e_i = v_k - v_j``
+    (``j, k`` the next two corners).
 
     Returns
     -------
     l2 : (m, 3) float64
-        ``l2[f, i]`` is the squared length of the edge opposite corner ``i``.
+        ``l2[f, i] = |e_i|^2`` (length^2).
     dblA : (m,) float64
-        Twice the triangle area, ``|(v1 - v0) x (v2 - v0)|``.
+        ``2 A_f = |(v1 - v0) x (v2 - v0)|`` (length^2).
     cot : (m, 3) float64
-        ``cot[f, i]`` is the cotangent of the angle at corner ``i``,
-        ``(l_j^2 + l_k^2 - l_i^2) / (4 A)``; zero on degenerate faces.
+        ``cot theta_i = <e_j, -e_k> / 2A = (l_j^2 + l_k^2 - l_i^2) / (4 A)``
+        (law of cosines over the cross product); 0 on zero-area faces.
     degenerate : (m,) bool
-        Zero-area faces: ``dblA <= ZERO_AREA_RTOL * (longest edge)^2``.
+        Zero-area faces (:func:`geomlib.validate.is_zero_area`).
     """
-    l2, dblA, cot, degenerate = _geometry(V, F)
+    V, F = as_mesh(V, F)
+    v0, v1, v2 = corner_positions(V, F)            # (3, m) coordinate rows of each corner
+    e = (v2 - v1, v0 - v2, v1 - v0)                # e_i = v_k - v_j, the edge opposite corner i
+    l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])   # |e_i|^2, (3, m)
+    N2 = cross(e[1], e[2])                         # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
+    dblA = np.sqrt(np.einsum("cf,cf->f", N2, N2))
+    degenerate = is_zero_area(dblA, l2.max(axis=0))
+    cot = (l2.sum(axis=0) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))
+    cot[:, degenerate] = 0.0
+    # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
     return l2.T, dblA, cot.T, degenerate
 
 
-def _warn_degenerate(degenerate, stacklevel=3):
+def warn_zero_area(degenerate):
+    """One MeshWarning naming the zero-area faces, if there are any."""
     if degenerate.any():
         idx = np.flatnonzero(degenerate)
-        warnings.warn(
-            f"{len(idx)} zero-area triangle(s) contribute nothing to the cotangent "
-            f"Laplacian and the vertex areas: faces {format_indices(idx)}",
-            MeshWarning,
-            stacklevel=stacklevel,
-        )
+        warnings.warn(f"{len(idx)} zero-area triangle(s) contribute nothing to the cotangent Laplacian "
+                      f"and the vertex areas: faces {format_indices(idx)}", MeshWarning, stacklevel=3)
 
 
-def _index_dtype(n):
-    return np.int32 if n < np.iinfo(np.int32).max else np.int64
+def uniform_laplacian(V, F):
+    """(M, C) of the uniform (graph) Laplacian: C_ij = 1 on every edge, C_ii = -valence, M = diag(valence).
 
-
-def _cot_matrix(n, F, cot):
-    """Assemble C from the (3, m) corner cotangents: edge (j, k) opposite corner i
-    gets 1/2 cot(angle at i), from each of its triangles."""
-    it = _index_dtype(n)
-    Ft = np.ascontiguousarray(F.T, dtype=it)
-    m = F.shape[0]
-    nnz = 6 * m + n
-    rows = np.empty(nnz, it)
-    cols = np.empty(nnz, it)
-    vals = np.empty(nnz)
-    # off-diagonal: edge (1,2) <- corner 0, (2,0) <- corner 1, (0,1) <- corner 2; both orders
-    for c, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
-        s = slice(c * m, (c + 1) * m)
-        t = slice((3 + c) * m, (4 + c) * m)
-        rows[s], cols[s] = Ft[j], Ft[k]
-        rows[t], cols[t] = Ft[k], Ft[j]
-        np.multiply(cot[c], 0.5, out=vals[s])
-        vals[t] = vals[s]
-    off = vals[: 6 * m]
-    diag = -np.bincount(rows[: 6 * m], weights=off, minlength=n)
-    rows[6 * m:] = cols[6 * m:] = np.arange(n, dtype=it)
-    vals[6 * m:] = diag
-    C = sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr()
-    return C
-
-
-def cotangent_weights(V, F):
-    """Symmetric cotangent matrix C (n, n): ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``.
-
-    Negative semidefinite, rows summing to zero (``C_ii = -sum_j C_ij``). On a
-    boundary edge only one angle exists and the weight is ``1/2 cot alpha``.
-    Zero-area triangles contribute nothing (MeshWarning); see the module
-    docstring for needle triangles. Pinkall and Polthier 1993; Meyer et al.
-    2003, eq. (8).
+    C is symmetric, NSD, rows sum to zero; ``M^-1 C x`` is the mean of the
+    neighbours minus ``x_i`` (the "umbrella" operator, Taubin 1995). No metric:
+    zero-area faces count like any other.
 
     Returns
     -------
+    M : (n, n) scipy.sparse DIA float64, the valences
     C : (n, n) scipy.sparse CSR float64
     """
-    V, F = _as_mesh(V, F)
-    _, _, cot, degenerate = _geometry(V, F)
-    _warn_degenerate(degenerate)
-    return _cot_matrix(len(V), F, cot)
+    V, F = as_mesh(V, F)
+    n = len(V)
+    E = edges(F)                                           # each edge ij once, i < j
+    ones = np.ones(len(E))
+    adjacency = sp.coo_matrix((np.r_[ones, ones], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
+                              shape=(n, n)).tocsr()
+    valence = np.diff(adjacency.indptr).astype(np.float64)
+    C = (adjacency - sp.diags(valence)).tocsr()
+    C.sort_indices()
+    return sp.diags(valence), C
 
 
-def _vertex_areas(n, F, l2, dblA, cot, area, degenerate=None):
-    """Vertex areas from (3, m) geometry arrays."""
-    A = 0.5 * dblA
-    if degenerate is not None:
-        A = np.where(degenerate, 0.0, A)
-    if area == "barycentric":
-        per_vertex = np.bincount(F.ravel(), weights=np.repeat(A / 3.0, 3), minlength=n)
-        return per_vertex
-    if area != "mixed":
-        _check_options(area=area)
-    # Voronoi part of the triangle at corner i: 1/8 (l_j^2 cot_j + l_k^2 cot_k)
-    # (Meyer et al. 2003, eq. 7); obtuse triangles: A/2 at the obtuse corner and
-    # A/4 at the other two (their Fig. 4, "mixed" area).
+def cotangent_matrix(V, F):
+    """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
+
+    Triangle ``(v0, v1, v2)`` adds ``1/2 cot theta_i`` to the edge ``(j, k)``
+    opposite its corner i. A boundary edge has one triangle, so one angle:
+    ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
+    Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
+    """
+    V, F = as_mesh(V, F)
+    n = len(V)
+    _, _, cot, degenerate = face_geometry(V, F)
+    warn_zero_area(degenerate)
+    index = np.int32 if n < 2**31 - 1 else np.int64
+    j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
+    w = 0.5 * cot.T.ravel()                                                        # gets 1/2 cot theta_i
+    diagonal = -(np.bincount(j, w, minlength=n) + np.bincount(k, w, minlength=n))  # rows sum to zero
+    d = np.arange(n, dtype=index)
+    rows, cols = np.concatenate([j, k, d]), np.concatenate([k, j, d])
+    return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
+
+
+def barycentric_areas(V, F):
+    """(n,) vertex areas A_i in length^2: a third of the area of every incident triangle.
+
+    Zero-area triangles add 0 (MeshWarning), so a vertex in no other triangle
+    has area 0. Sums to the surface area.
+    """
+    V, F = as_mesh(V, F)
+    _, dblA, _, degenerate = face_geometry(V, F)
+    warn_zero_area(degenerate)
+    third = np.where(degenerate, 0.0, dblA / 6.0)
+    return np.bincount(F.T.ravel(), np.tile(third, 3), minlength=len(V))
+
+
+def mixed_areas(V, F):
+    """(n,) mixed Voronoi vertex areas A_i in length^2 (Meyer et al. 2003, Fig. 4).
+
+    Per triangle and corner i (j, k the other two corners, A the triangle area):
+
+    * no obtuse angle: the Voronoi part ``1/8 (|e_j|^2 cot theta_j + |e_k|^2 cot theta_k)``,
+      the two edges at i weighted by the cotangents of the angles opposite them;
+    * obtuse at i: ``A / 2`` (the Voronoi region would leave the triangle);
+    * obtuse at another corner: ``A / 4``.
+
+    Sums to the surface area. Zero-area triangles add 0 (MeshWarning).
+    """
+    V, F = as_mesh(V, F)
+    l2, dblA, cot, degenerate = face_geometry(V, F)
+    warn_zero_area(degenerate)
+    A = 0.5 * dblA[:, None]
     lc = l2 * cot
-    per_corner = np.empty_like(l2)
-    per_corner[0] = (lc[1] + lc[2]) * 0.125
-    per_corner[1] = (lc[2] + lc[0]) * 0.125
-    per_corner[2] = (lc[0] + lc[1]) * 0.125
-    obtuse = cot < 0
-    any_obtuse = obtuse.any(axis=0)
-    if any_obtuse.any():
-        Aq = np.broadcast_to(0.25 * A, per_corner.shape)
-        per_corner = np.where(any_obtuse, np.where(obtuse, 2.0 * Aq, Aq), per_corner)
-    if degenerate is not None:
-        per_corner[:, degenerate] = 0.0
-    return np.bincount(F.T.ravel(), weights=per_corner.ravel(), minlength=n)
+    voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
+    obtuse = cot < 0                                    # cot theta < 0 <=> theta > pi/2
+    obtuse_triangle = obtuse.any(axis=1, keepdims=True)
+    per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
+    per_corner[degenerate] = 0.0
+    return np.bincount(F.T.ravel(), per_corner.T.ravel(), minlength=len(V))
 
 
 def vertex_areas(V, F, area="barycentric"):
-    """Vertex areas (n,) float64 in length^2: the diagonal of the cotangent M.
+    """(n,) vertex areas A_i in length^2, the diagonal of the cotangent M.
 
-    ``area="barycentric"``: a third of the area of every incident triangle.
-    ``area="mixed"``: the mixed Voronoi area of Meyer et al. 2003 (Fig. 4):
-    the Voronoi region inside non-obtuse triangles, and half (at the obtuse
-    corner) or a quarter (at the other corners) of an obtuse triangle's area.
-    Both sum to the total surface area. Zero-area triangles contribute 0, so a
-    vertex that is in no other triangle gets area 0.
+    ``area="barycentric"``: :func:`barycentric_areas`; ``"mixed"``:
+    :func:`mixed_areas` (Meyer et al. 2003). Both sum to the surface area.
     """
-    _check_options(area=area)
-    V, F = _as_mesh(V, F)
-    l2, dblA, cot, degenerate = _geometry(V, F)
-    _warn_degenerate(degenerate)
-    return _vertex_areas(len(V), F, l2, dblA, cot, area, degenerate)
-
-
-def uniform_adjacency(n, F):
-    """Adjacency matrix (n, n) CSR float64 with 1 for every edge ij (each edge once)."""
-    F = np.asarray(F)
-    it = _index_dtype(n)
-    I = np.concatenate([F[:, 0], F[:, 1], F[:, 2]]).astype(it)
-    J = np.concatenate([F[:, 1], F[:, 2], F[:, 0]]).astype(it)
-    keep = I != J  # a face repeating a vertex adds no self-loop
-    I, J = I[keep], J[keep]
-    A = sp.coo_matrix((np.ones(2 * len(I)), (np.concatenate([I, J]), np.concatenate([J, I]))),
-                      shape=(n, n)).tocsr()
-    A.data[:] = 1.0  # an interior edge was counted twice (once per triangle)
-    return A
+    check_options(area=area)
+    return barycentric_areas(V, F) if area == "barycentric" else mixed_areas(V, F)
 
 
 def laplacian(V, F, weights="cotan", area="barycentric"):
-    """Discrete Laplace-Beltrami operator ``Delta = M^-1 C`` as the pair (M, C); C is NSD.
-
-    C is symmetric, negative semidefinite, rows sum to zero; off-diagonal
-    ``1/2 (cot alpha_ij + cot beta_ij)`` for ``weights="cotan"`` and 1 for
-    ``weights="uniform"``. M is diagonal: vertex areas in length^2 for
-    "cotan" (``area="barycentric"``: a third of the incident triangle areas;
-    ``area="mixed"``: Meyer et al. 2003) and the valence for "uniform" (then
-    ``area`` is ignored). With this sign ``Delta x = -2 H n`` for the outward
-    unit normal n, H > 0 on a sphere.
+    """The Laplace-Beltrami operator ``Delta = M^-1 C`` as the pair (M, C); C is NSD.
 
     Parameters
     ----------
@@ -275,63 +198,53 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     F : (m, 3) int64
         Triangles, counter-clockwise seen from outside.
     weights : {"cotan", "uniform"}
+        :func:`cotangent_matrix` with vertex areas, or :func:`uniform_laplacian`
+        (then ``area`` is ignored and M holds the valences).
     area : {"barycentric", "mixed"}
+        The vertex areas of M (:func:`vertex_areas`).
 
     Returns
     -------
-    M : (n, n) scipy.sparse diagonal (DIA) float64
+    M : (n, n) scipy.sparse DIA float64
     C : (n, n) scipy.sparse CSR float64
+        Symmetric, negative semidefinite, rows summing to zero. With this sign
+        ``Delta x = -2 H n`` for the outward unit normal n, H > 0 on a sphere.
 
     Raises
     ------
     MeshError
-        Unknown ``weights`` or ``area``; malformed V or F (see
-        :func:`geomlib.validate.as_mesh`).
+        Unknown ``weights`` or ``area``; malformed V or F (:func:`geomlib.validate.as_mesh`).
 
     Notes
     -----
-    Boundary edges have one triangle and get ``1/2 cot alpha``; boundary
-    vertices are treated like any other (the operator is then the one with
-    natural Neumann boundary conditions). Zero-area triangles contribute
-    nothing (MeshWarning naming them); isolated vertices get a zero row in C
-    and a zero in M; nothing in M or C is ever NaN or infinite (module
-    docstring). Vectorised assembly, O(n + m).
-
-    References: Pinkall and Polthier 1993; Desbrun, Meyer, Schroeder and
-    Barr 1999; Meyer, Desbrun, Schroeder and Barr 2003, "Discrete
-    differential-geometry operators for triangulated 2-manifolds".
+    Boundary edges have one triangle and get ``1/2 cot alpha``: the operator
+    with natural (Neumann) boundary conditions. See the module docstring for
+    zero-area and needle triangles and isolated vertices.
+    Pinkall and Polthier 1993; Desbrun et al. 1999; Meyer et al. 2003.
     """
-    _check_options(weights, area)
-    V, F = _as_mesh(V, F)
-    n = len(V)
+    check_options(weights, area)
+    V, F = as_mesh(V, F)
     if weights == "uniform":
-        A = uniform_adjacency(n, F)
-        deg = np.diff(A.indptr).astype(np.float64)
-        C = (A - sp.diags(deg, format="csr")).tocsr()
-        C.sort_indices()
-        return sp.diags(deg), C
-    l2, dblA, cot, degenerate = _geometry(V, F)
-    _warn_degenerate(degenerate)
-    C = _cot_matrix(n, F, cot)
-    M = sp.diags(_vertex_areas(n, F, l2, dblA, cot, area, degenerate))
+        return uniform_laplacian(V, F)
+    C = cotangent_matrix(V, F)                      # names the zero-area faces, if any
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)  # the same faces: named once is enough
+        M = sp.diags(vertex_areas(V, F, area))
     return M, C
 
 
-def uniform_laplacian(V, F):
-    """(M, C) of the uniform Laplacian: C_ij = 1 on edges, C_ii = -valence, M = diag(valence)."""
-    return laplacian(V, F, weights="uniform")
+def cotangent_weights(V, F):
+    """The cotangent matrix C (n, n); the name the package exports for :func:`cotangent_matrix`."""
+    return cotangent_matrix(V, F)
 
 
-def cotangent_matrix(V, F):
-    """C of the cotangent Laplacian: C_ij = (cot alpha_ij + cot beta_ij) / 2, rows summing to zero."""
-    return laplacian(V, F, weights="cotan")[1]
+def uniform_adjacency(n, F):
+    """Adjacency matrix (n, n) CSR float64 with 1 for every edge ij (each edge once, both directions)."""
+    M, C = uniform_laplacian(np.zeros((n, 3)), F)
+    A = (C + M).tocsr()
+    A.eliminate_zeros()
+    return A
 
 
-def barycentric_areas(V, F):
-    """(n,) vertex areas: a third of the areas of the incident triangles."""
-    return vertex_areas(V, F, area="barycentric")
-
-
-def mixed_areas(V, F):
-    """(n,) mixed Voronoi vertex areas (Meyer et al. 2003)."""
-    return vertex_areas(V, F, area="mixed")
+# geomlib.smoothing still imports the validator under this name; it goes once smoothing calls validate.as_mesh
+_as_mesh = as_mesh

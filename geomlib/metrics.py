@@ -9,13 +9,11 @@ the default; a fraction, 0.01 = 1 % of the diagonal) or in the mesh's length
 units (``relative=False``). Angles are in degrees. Relative changes of area and
 volume are signed fractions, ``(X - X_clean) / |X_clean|``.
 
-The functions take the arrays and recompute what they need. For many
-comparisons against the same clean mesh (a parameter sweep) build one
-:class:`MeshComparison`: it computes the clean mesh's normals, edges,
-dihedral angles, area, volume and surface samples once.
-:func:`smoothing_sweep` runs explicit and implicit smoothing (uniform and
-cotangent weights) over noise levels, scale-free steps and iteration counts
-and records every metric (notebook 07).
+Each metric is one function taking the arrays. :class:`MeshComparison`
+holds one clean mesh and its properties (diagonal, closedness, sharp edges)
+and calls the same functions. The smoothing sweep of notebook 07 that uses
+them is :mod:`geomlib.sweep`; the elementary measurements (area, volume,
+bounding-box diagonal, mean edge length) are :mod:`geomlib.geometry`'s.
 
 Degenerate and special cases are stated where they are handled:
 
@@ -32,7 +30,15 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .errors import MeshError
+from .geometry import bounding_box_diagonal, enclosed_volume, face_cross, mean_edge_length, surface_area
+from .topology import Topology
 from .validate import as_faces, as_vertices
+
+__all__ = ["SHARP_ANGLE", "HAUSDORFF_SAMPLES_PER_FACE", "vertex_rms", "hausdorff_distance", "face_normal_angles",
+           "normal_angle_error", "area_change", "volume_change", "dihedral_angles", "sharp_edges",
+           "sharp_edge_error", "denoising_metrics", "MeshComparison", "interior_edges", "point_triangle_distance",
+           "point_surface_distance", "sample_surface", "bounding_box_diagonal", "surface_area",
+           "enclosed_volume", "mean_edge_length"]
 
 #: Default threshold (degrees) on the clean mesh's dihedral (bend) angle above
 #: which an edge counts as a sharp feature edge.
@@ -53,59 +59,6 @@ def _same_shape(V, V_clean):
                         f"got {V.shape} and {V_clean.shape}")
 
 
-def bounding_box_diagonal(V):
-    """Length of the diagonal of the axis-aligned bounding box of V (length units).
-
-    Parameters
-    ----------
-    V : (n, 3) float64 vertex positions.
-
-    Returns
-    -------
-    float
-        ``|max(V) - min(V)|`` taken over the three axes.
-    """
-    V = as_vertices(V)
-    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
-
-
-# ----------------------------------------------------------------------------
-# elementary geometry
-# ----------------------------------------------------------------------------
-
-def _cross_faces(V, F):
-    """Per-face cross products ``(v1 - v0) x (v2 - v0)`` = 2 A n, (m, 3)."""
-    P0 = V[F[:, 0]]
-    a = V[F[:, 1]] - P0
-    b = V[F[:, 2]] - P0
-    N = np.empty_like(a)
-    N[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    N[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    N[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return N
-
-
-def _norms(X):
-    return np.sqrt(X[:, 0] * X[:, 0] + X[:, 1] * X[:, 1] + X[:, 2] * X[:, 2])
-
-
-def surface_area(V, F):
-    """Total area of the triangles (length^2)."""
-    V = as_vertices(V)
-    F = as_faces(F, len(V))
-    return 0.5 * float(np.linalg.norm(_cross_faces(V, F), axis=1).sum())
-
-
-def enclosed_volume(V, F):
-    """Signed enclosed volume (length^3) by the divergence theorem,
-    ``1/6 sum_f v0 . (v1 x v2)``: positive for a closed mesh whose faces are
-    counter-clockwise seen from outside. Only meaningful for a closed mesh
-    (on an open one it depends on the origin); this function does not check."""
-    V = as_vertices(V)
-    F = as_faces(F, len(V))
-    return float(np.einsum("ij,ij->", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])) / 6.0)
-
-
 def interior_edges(F):
     """Edges shared by exactly two consistently oriented faces, and the rest.
 
@@ -124,29 +77,11 @@ def interior_edges(F):
     other : (c, 2) int64
         Non-manifold or inconsistently oriented edges (neither of the above).
     """
-    F = np.asarray(F, dtype=np.int64)
-    m = len(F)
-    I = F.ravel()
-    J = F[:, [1, 2, 0]].ravel()
-    face = np.repeat(np.arange(m), 3)
-    lo, hi = np.minimum(I, J), np.maximum(I, J)
-    n = int(F.max()) + 1 if m else 0
-    key = lo * n + hi
-    order = np.argsort(key, kind="stable")
-    key_sorted = key[order]
-    starts = np.flatnonzero(np.r_[True, key_sorted[1:] != key_sorted[:-1]])
-    counts = np.diff(np.r_[starts, len(key_sorted)])
-    first = order[starts]
-    boundary = np.column_stack([I[first[counts == 1]], J[first[counts == 1]]])
-    two = counts == 2
-    a = order[starts[two]]
-    b = order[starts[two] + 1]
-    opposite = (I[a] == J[b]) & (J[a] == I[b])
-    a, b = a[opposite], b[opposite]
-    E = np.column_stack([I[a], J[a]])
-    other_first = np.r_[first[counts > 2], order[starts[two]][~opposite]]
-    other = np.column_stack([I[other_first], J[other_first]])
-    return E, face[a], face[b], boundary.astype(np.int64), other.astype(np.int64)
+    F = as_faces(F)
+    T = Topology(F, int(F.max()) + 1)
+    E, f1, f2 = T.face_pairs()
+    other = np.vstack([T.E[T.edge_face_count > 2], T.inconsistent_edges()])
+    return E, f1, f2, T.boundary_edges(), other.astype(np.int64)
 
 
 def dihedral_angles(V, F, edges=None):
@@ -181,7 +116,7 @@ def dihedral_angles(V, F, edges=None):
 
 
 def _bend_angles(V, F, E, f1, f2, N=None):
-    N = _cross_faces(V, F) if N is None else N
+    N = face_cross(V, F) if N is None else N
     n1, n2 = N[f1], N[f2]
     angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1),
                                   np.einsum("ij,ij->i", n1, n2)))
@@ -340,7 +275,7 @@ def sample_surface(V, F, count, seed):
 def _sample(V, F, count, rng):
     if count <= 0:
         return np.empty((0, 3))
-    area = np.linalg.norm(_cross_faces(V, F), axis=1)
+    area = np.linalg.norm(face_cross(V, F), axis=1)
     total = area.sum()
     if total <= 0:
         return np.empty((0, 3))
@@ -356,13 +291,10 @@ def _sample(V, F, count, rng):
 # ----------------------------------------------------------------------------
 
 class MeshComparison:
-    """Metrics of meshes with the connectivity ``F`` against one clean mesh ``V_clean``.
+    """One clean mesh ``(V_clean, F)`` to compare meshes of the same connectivity against.
 
-    Everything that depends on the clean mesh only (its bounding-box
-    diagonal, face normals, interior edges and their bend angles, the sharp
-    edges, area, volume, the surface samples and the search tree for
-    distances to it) is computed once here; :meth:`evaluate` then costs a few
-    vectorised passes over the faces (plus the Hausdorff estimate when asked).
+    Holds the clean mesh, its properties and the metric settings; every
+    method calls the function of the same name (one implementation each).
 
     Parameters
     ----------
@@ -374,10 +306,9 @@ class MeshComparison:
         Degrees; an interior edge is *sharp* when the absolute bend angle of
         the clean mesh there exceeds this (default :data:`SHARP_ANGLE`).
     samples_per_face : float
-        Density of the Hausdorff estimate: ``round(samples_per_face * m)``
-        area-weighted random points on each surface, plus all its vertices.
+        Density of the Hausdorff estimate (:func:`hausdorff_distance`).
     seed : int
-        Seed of the surface samples (the same seed gives the same estimate).
+        Seed of the Hausdorff surface samples (the same seed, the same estimate).
 
     Attributes
     ----------
@@ -385,6 +316,10 @@ class MeshComparison:
         Bounding-box diagonal of the clean mesh (length units).
     closed : bool
         True when every edge is shared by exactly two opposite faces.
+    edges : (k, 2) int64
+        The interior edges (:func:`interior_edges`).
+    bend_clean : (k,) float64
+        The clean mesh's signed bend angles there (degrees).
     sharp : (s,) int64
         Indices (into ``edges``) of the sharp edges.
     """
@@ -401,18 +336,10 @@ class MeshComparison:
         if not self.samples_per_face >= 0:
             raise MeshError(f"samples_per_face must be >= 0, got {samples_per_face}")
         self.seed = seed
-        E, f1, f2, boundary, other = interior_edges(self.F)
-        self.edges, self._f1, self._f2 = E, f1, f2
+        _, _, _, boundary, other = interior_edges(self.F)
         self.closed = len(boundary) == 0 and len(other) == 0
-        self._N_clean = _cross_faces(self.V_clean, self.F)
-        self.area_clean = 0.5 * float(np.linalg.norm(self._N_clean, axis=1).sum())
-        self.volume_clean = _volume(self.V_clean, self.F, self._N_clean) if self.closed else float("nan")
-        self.bend_clean = _bend_angles(self.V_clean, self.F, E, f1, f2)
+        self.edges, self.bend_clean = dihedral_angles(self.V_clean, self.F)
         self.sharp = np.flatnonzero(np.abs(self.bend_clean) > self.sharp_angle)
-        self._index_clean = None
-        self._points_clean = None
-
-    # -- single metrics ------------------------------------------------------
 
     def _check(self, V):
         V = as_vertices(V)
@@ -420,139 +347,59 @@ class MeshComparison:
         return V
 
     def vertex_rms(self, V, relative=True):
-        """``sqrt(mean_i |v_i - v_i^clean|^2)``, relative to the clean diagonal by default."""
-        V = self._check(V)
-        rms = float(np.sqrt(np.mean(np.einsum("ij,ij->i", V - self.V_clean, V - self.V_clean))))
-        return rms / self.diagonal if relative else rms
+        """:func:`vertex_rms` against the clean mesh."""
+        return vertex_rms(self._check(V), self.V_clean, relative)
 
     def face_normal_angles(self, V):
-        """Angle (degrees) between each face's normal and the clean one, (m,)."""
-        V = self._check(V)
-        return _normal_angles(_cross_faces(V, self.F), self._N_clean)
+        """:func:`face_normal_angles` against the clean mesh, (m,) degrees."""
+        return face_normal_angles(self._check(V), self.V_clean, self.F)
 
     def sharp_edge_error(self, V):
-        """Mean absolute error (degrees) of the bend angle on the clean mesh's
-        sharp edges; NaN when the clean mesh has no sharp edge."""
-        V = self._check(V)
-        if len(self.sharp) == 0:
-            return float("nan")
-        E, f1, f2 = self.edges[self.sharp], self._f1[self.sharp], self._f2[self.sharp]
-        bend = _bend_angles(V, self.F, E, f1, f2)
-        return float(np.mean(np.abs(bend - self.bend_clean[self.sharp])))
+        """:func:`sharp_edge_error` with this comparison's ``sharp_angle``; NaN without sharp edges."""
+        return sharp_edge_error(self._check(V), self.V_clean, self.F, self.sharp_angle)
 
     def hausdorff(self, V, relative=True, seed=None):
-        """Symmetric Hausdorff distance between the surfaces (V, F) and (V_clean, F).
-
-        ``max(sup_{p on S} d(p, S_clean), sup_{q on S_clean} d(q, S))``,
-        estimated as the maximum over all vertices plus
-        ``round(samples_per_face * m)`` area-weighted random points of each
-        surface, each measured exactly to the other surface (closest point in
-        a triangle, on an edge or at a corner). Being a maximum over finitely
-        many points it is an estimate *from below*: the true value is at least
-        this, and since ``d(p, S)`` changes by at most ``|p - q|`` from p to q
-        it exceeds the estimate by at most the covering radius of the samples
-        (the largest distance from a point of a surface to its nearest
-        sample), which shrinks as the density grows. Relative to the clean
-        diagonal by default.
-        """
-        V = self._check(V)
-        if self._index_clean is None:
-            self._index_clean = _SurfaceIndex(self.V_clean, self.F)
-            rng = np.random.default_rng(self.seed)
-            count = int(round(self.samples_per_face * len(self.F)))
-            self._points_clean = np.vstack([self.V_clean[np.unique(self.F)],
-                                            _sample(self.V_clean, self.F, count, rng)])
-        rng = np.random.default_rng(self.seed + 1 if seed is None else seed)
-        count = int(round(self.samples_per_face * len(self.F)))
-        points = np.vstack([V[np.unique(self.F)], _sample(V, self.F, count, rng)])
-        there = self._index_clean.max_distance(points)
-        back = _SurfaceIndex(V, self.F).max_distance(self._points_clean)
-        h = float(max(there, back))
-        return h / self.diagonal if relative else h
+        """:func:`hausdorff_distance` to the clean surface, with this comparison's density and seed."""
+        return hausdorff_distance(self._check(V), self.V_clean, self.F, relative=relative,
+                                  samples_per_face=self.samples_per_face, seed=self.seed if seed is None else seed)
 
     def area_change(self, V):
-        """``(A - A_clean) / A_clean``: signed relative change of the surface area."""
-        V = self._check(V)
-        return 0.5 * float(np.linalg.norm(_cross_faces(V, self.F), axis=1).sum()) / self.area_clean - 1.0
+        """:func:`area_change`: ``(A - A_clean) / A_clean``."""
+        return area_change(self._check(V), self.V_clean, self.F)
 
     def volume_change(self, V):
-        """``(vol - vol_clean) / |vol_clean|``; raises MeshError on an open mesh."""
-        V = self._check(V)
-        if not self.closed:
-            raise MeshError("the volume change is defined for closed meshes only; this mesh has "
-                            "boundary or non-manifold edges")
-        return (_volume(V, self.F, _cross_faces(V, self.F)) - self.volume_clean) / abs(self.volume_clean)
-
-    # -- all at once -----------------------------------------------------------
+        """:func:`volume_change`: ``(vol - vol_clean) / |vol_clean|``; MeshError on an open mesh."""
+        return volume_change(self._check(V), self.V_clean, self.F)
 
     def evaluate(self, V, hausdorff=True):
         """All metrics of V against the clean mesh, as a dict.
 
         Keys (lengths relative to the clean bounding-box diagonal, angles in
-        degrees): ``"rms"`` vertex RMS distance; ``"hausdorff"`` symmetric
-        surface Hausdorff estimate (only when ``hausdorff=True``);
-        ``"normal_mean"`` and ``"normal_p95"`` mean and 95th percentile of
-        the face-normal angle error; ``"area_change"`` and
-        ``"volume_change"`` signed relative changes (``volume_change`` is NaN
-        for an open mesh, whose volume is undefined); ``"sharp_edge_error"``
-        mean absolute bend-angle error on the sharp edges (NaN when the clean
-        mesh has none).
+        degrees): ``"rms"`` (:func:`vertex_rms`); ``"hausdorff"`` (only when
+        ``hausdorff=True``); ``"normal_mean"`` and ``"normal_p95"``
+        (:func:`normal_angle_error`); ``"area_change"``; ``"volume_change"``
+        (NaN for an open mesh, whose volume is undefined);
+        ``"sharp_edge_error"`` (NaN when the clean mesh has no sharp edge).
         """
         V = self._check(V)
-        N = _cross_faces(V, self.F)
-        angles = _normal_angles(N, self._N_clean)
-        D = V - self.V_clean
-        out = {"rms": float(np.sqrt(np.mean(D * D) * 3)) / self.diagonal}
+        out = {"rms": self.vertex_rms(V)}
         if hausdorff:
             out["hausdorff"] = self.hausdorff(V)
-        out["normal_mean"] = float(angles.mean())
-        out["normal_p95"] = _percentile(angles, 95.0)
-        out["area_change"] = 0.5 * float(_norms(N).sum()) / self.area_clean - 1.0
-        if self.closed:
-            out["volume_change"] = (_volume(V, self.F, N) - self.volume_clean) / abs(self.volume_clean)
-        else:
-            out["volume_change"] = float("nan")
-        if len(self.sharp):
-            s = self.sharp
-            bend = _bend_angles(V, self.F, self.edges[s], self._f1[s], self._f2[s], N)
-            out["sharp_edge_error"] = float(np.mean(np.abs(bend - self.bend_clean[s])))
-        else:
-            out["sharp_edge_error"] = float("nan")
+        out["normal_mean"], out["normal_p95"] = normal_angle_error(V, self.V_clean, self.F)
+        out["area_change"] = self.area_change(V)
+        out["volume_change"] = self.volume_change(V) if self.closed else float("nan")
+        out["sharp_edge_error"] = self.sharp_edge_error(V)
         return out
-
-
-def _percentile(x, q):
-    """``np.percentile(x, q)`` (linear interpolation) from two order statistics."""
-    pos = q / 100.0 * (len(x) - 1)
-    lo = int(np.floor(pos))
-    hi = min(lo + 1, len(x) - 1)
-    part = np.partition(x, [lo, hi])
-    return float(part[lo] + (pos - lo) * (part[hi] - part[lo]))
-
-
-def _volume(V, F, N):
-    """Enclosed volume from the face cross products N:
-    ``v0 . ((v1 - v0) x (v2 - v0)) = v0 . (v1 x v2)``, summed, over 6."""
-    return float((V[F[:, 0]] * N).sum()) / 6.0
 
 
 def _normal_angles(N, N_clean):
     """Angles (degrees) between the rows of two arrays of (unnormalised)
     normals; rows with a zero vector (degenerate faces) count as 90."""
-    X = np.empty_like(N)
-    X[:, 0] = N[:, 1] * N_clean[:, 2] - N[:, 2] * N_clean[:, 1]
-    X[:, 1] = N[:, 2] * N_clean[:, 0] - N[:, 0] * N_clean[:, 2]
-    X[:, 2] = N[:, 0] * N_clean[:, 1] - N[:, 1] * N_clean[:, 0]
-    dot = N[:, 0] * N_clean[:, 0] + N[:, 1] * N_clean[:, 1] + N[:, 2] * N_clean[:, 2]
-    angle = np.degrees(np.arctan2(_norms(X), dot))
-    zero = (_norms(N) == 0) | (_norms(N_clean) == 0)
+    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(N, N_clean), axis=1), np.einsum("ij,ij->i", N, N_clean)))
+    zero = (np.linalg.norm(N, axis=1) == 0) | (np.linalg.norm(N_clean, axis=1) == 0)
     angle[zero] = 90.0
     return angle
 
-
-# ----------------------------------------------------------------------------
-# function forms
-# ----------------------------------------------------------------------------
 
 def vertex_rms(V, V_clean, relative=True):
     """Vertex RMS distance ``sqrt(mean_i |v_i - v_i^clean|^2)`` (same vertex order).
@@ -632,7 +479,7 @@ def face_normal_angles(V, V_clean, F):
     V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
     F = as_faces(F, len(V))
-    return _normal_angles(_cross_faces(V, F), _cross_faces(V_clean, F))
+    return _normal_angles(face_cross(V, F), face_cross(V_clean, F))
 
 
 def normal_angle_error(V, V_clean, F):
@@ -700,246 +547,16 @@ def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE):
     V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
     F = as_faces(F, len(V))
-    return MeshComparison(V_clean, F, sharp_angle=threshold).sharp_edge_error(V)
+    E, f1, f2, _, _ = interior_edges(F)
+    bend_clean = _bend_angles(V_clean, F, E, f1, f2)
+    sharp = np.abs(bend_clean) > threshold
+    if not sharp.any():
+        return float("nan")
+    bend = _bend_angles(V, F, E[sharp], f1[sharp], f2[sharp])
+    return float(np.mean(np.abs(bend - bend_clean[sharp])))
 
 
 def denoising_metrics(V, V_clean, F, sharp_angle=SHARP_ANGLE,
                       samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
     """Every metric of V against the clean mesh, as a dict (see :meth:`MeshComparison.evaluate`)."""
     return MeshComparison(V_clean, F, sharp_angle, samples_per_face, seed).evaluate(V)
-
-
-# ----------------------------------------------------------------------------
-# a sweep of Laplacian smoothing over noise levels, schemes, steps, iterations
-# ----------------------------------------------------------------------------
-
-#: (method, weights) pairs compared by :func:`smoothing_sweep`.
-SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"),
-           ("implicit", "uniform"), ("implicit", "cotan"))
-
-#: Explicit steps of the sweep, as fractions of the stability limit
-#: ``2 / lambda_max`` of the mesh being smoothed (below 1 is stable).
-EXPLICIT_FRACTIONS = (0.1, 0.25, 0.5, 0.9)
-
-#: Implicit steps of the sweep, scale-free (see :func:`scale_free_step`).
-IMPLICIT_STEPS = (0.1, 0.3, 1.0)
-
-#: Iteration counts at which the sweep measures every run.
-SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
-
-#: Metric keys recorded by the sweep (all of :meth:`MeshComparison.evaluate`
-#: except the Hausdorff estimate, which is measured for chosen results only).
-SWEEP_KEYS = ("rms", "normal_mean", "normal_p95", "area_change", "volume_change",
-              "sharp_edge_error")
-
-
-def unique_edges(F):
-    """Every edge of the triangles once, as sorted vertex pairs (k, 2) int64."""
-    F = np.asarray(F, dtype=np.int64)
-    E = np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    return np.unique(E, axis=0)
-
-
-def mean_edge_length(V, F, edges=None):
-    """Mean length of the mesh's edges, each counted once (length units).
-
-    ``edges``: the result of :func:`unique_edges` for F, to avoid recomputing it."""
-    V = as_vertices(V)
-    F = as_faces(F, len(V))
-    E = unique_edges(F) if edges is None else edges
-    return float(_norms(V[E[:, 0]] - V[E[:, 1]]).mean())
-
-
-def scale_free_step(V, F, method, weights, value, edges=None):
-    """The smoothing step (units of :mod:`geomlib.smoothing`) for a scale-free ``value``.
-
-    * explicit: ``value`` is a fraction of the stability limit of this mesh,
-      ``step = value * explicit_step_limit(V, F, weights)``.
-    * implicit, uniform weights: ``Delta`` is dimensionless, ``step = value``.
-    * implicit, cotangent weights: ``step = value * h^2 / 4`` with ``h`` the
-      mean edge length of this mesh. On an equilateral mesh the cotangent
-      Laplacian is the uniform one divided by ``h^2 / 4``, so the same
-      ``value`` diffuses by the same amount with either weights, at any scale.
-
-    For the cotangent operator of a *noisy* mesh the explicit limit collapses
-    (noise makes obtuse triangles with large cotangents), which is why the
-    implicit step is not tied to it.
-    """
-    if method == "explicit":
-        from .smoothing import explicit_step_limit
-
-        return float(value) * explicit_step_limit(V, F, weights)
-    if method != "implicit":
-        raise MeshError(f"method must be 'explicit' or 'implicit', not {method!r}")
-    if weights == "uniform":
-        return float(value)
-    if weights == "cotan":
-        return float(value) * mean_edge_length(V, F, edges) ** 2 / 4.0
-    raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
-
-
-class SmoothingSweep:
-    """Results of :func:`smoothing_sweep`: every metric for every setting.
-
-    Attributes
-    ----------
-    sigmas : (a,) float64
-        Noise levels (fractions of the bounding-box diagonal).
-    schemes : list of (method, weights)
-    step_values : dict method -> tuple
-        The scale-free step values (:func:`scale_free_step`).
-    steps : (a, s, b) float64
-        The actual step used for noise level i, scheme j, step value k.
-    iterations : (c,) int64
-    values : dict key -> (a, s, b, c) float64
-        ``values["rms"][i, j, k, l]``: the metric after ``iterations[l]``
-        iterations. NaN where a run stopped early (divergence).
-    noisy : dict key -> (a,) float64
-        The metrics of the noisy input itself.
-    seconds : float
-        Wall-clock time of the sweep.
-    """
-
-    def __init__(self, sigmas, schemes, step_values, iterations):
-        self.sigmas = np.asarray(sigmas, dtype=np.float64)
-        self.schemes = list(schemes)
-        self.step_values = dict(step_values)
-        self.iterations = np.asarray(iterations, dtype=np.int64)
-        b = max(len(v) for v in self.step_values.values())
-        shape = (len(self.sigmas), len(self.schemes), b, len(self.iterations))
-        self.steps = np.full(shape[:3], np.nan)
-        self.values = {key: np.full(shape, np.nan) for key in SWEEP_KEYS}
-        self.noisy = {key: np.full(len(self.sigmas), np.nan) for key in SWEEP_KEYS}
-        self.seconds = float("nan")
-
-    def best(self, i, key="rms", schemes=None):
-        """The setting with the smallest ``key`` at noise level ``i``.
-
-        Parameters
-        ----------
-        i : int
-            Index into ``sigmas``.
-        key : str
-            A metric of ``values`` (smaller is better; for signed changes the
-            absolute value counts).
-        schemes : list of (method, weights), optional
-            Restrict the search to these schemes.
-
-        Returns
-        -------
-        dict with ``method``, ``weights``, ``step_value``, ``step``,
-        ``iterations``, the metrics of that setting (every key of ``values``)
-        and ``index`` (j, k, l) into ``values``.
-        """
-        allowed = [j for j, s in enumerate(self.schemes) if schemes is None or s in schemes]
-        block = np.abs(self.values[key][i])
-        mask = np.full(block.shape, np.inf)
-        mask[allowed] = 0.0
-        block = np.where(np.isnan(block), np.inf, block) + mask
-        j, k, l = np.unravel_index(int(np.argmin(block)), block.shape)
-        method, weights = self.schemes[j]
-        out = {"method": method, "weights": weights,
-               "step_value": self.step_values[method][k], "step": float(self.steps[i, j, k]),
-               "iterations": int(self.iterations[l]), "index": (int(j), int(k), int(l))}
-        out.update({name: float(v[i, j, k, l]) for name, v in self.values.items()})
-        return out
-
-
-def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fractions=EXPLICIT_FRACTIONS,
-                    implicit_steps=IMPLICIT_STEPS, iterations=SWEEP_ITERATIONS, direction="isotropic",
-                    comparison=None, progress=True):
-    """Add noise at each level, smooth it with every scheme, step and iteration count, measure.
-
-    For every noise level ``sigma`` (a fraction of the bounding-box
-    diagonal) the noisy mesh is ``add_noise(V_clean, F, sigma, seed,
-    direction)`` (the same seed at every level: the same noise pattern,
-    growing). Every scheme ``(method, weights)`` then smooths it with every
-    step value (:func:`scale_free_step`) for ``max(iterations)`` iterations,
-    and the mesh is measured against the clean one after each count in
-    ``iterations`` (:meth:`MeshComparison.evaluate` without the Hausdorff
-    estimate). One run per (noise level, scheme, step) covers all iteration
-    counts; implicit runs factorise ``M - step C`` once per (noisy mesh,
-    weights, step) and reuse it (:class:`geomlib.smoothing.ImplicitSmoother`).
-    The operators are those of the noisy mesh, built once per run and kept
-    fixed (as in :func:`geomlib.explicit_smoothing` and
-    :func:`geomlib.implicit_smoothing`).
-
-    Parameters
-    ----------
-    V_clean : (n, 3) float64
-    F : (m, 3) int64
-    sigmas : sequence of float
-    seed : int
-    schemes : sequence of (method, weights)
-    explicit_fractions, implicit_steps : sequence of float
-        Scale-free step values of the explicit and implicit runs.
-    iterations : sequence of int
-        Increasing iteration counts at which to measure.
-    direction : "isotropic" or "normal"
-        Of the noise (:func:`geomlib.add_noise`).
-    comparison : MeshComparison, optional
-        Reuse one built for (V_clean, F).
-    progress : bool
-        A tqdm.auto progress bar over the runs.
-
-    Returns
-    -------
-    SmoothingSweep
-    """
-    import time
-    import warnings
-
-    from .errors import MeshWarning
-    from .noise import add_noise
-    from .smoothing import ImplicitSmoother, explicit_smoothing
-
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
-    iterations = np.asarray(sorted(set(int(k) for k in iterations)), dtype=np.int64)
-    if len(iterations) == 0 or iterations[0] < 1:
-        raise MeshError("iterations must be positive whole numbers")
-    step_values = {"explicit": tuple(explicit_fractions), "implicit": tuple(implicit_steps)}
-    for method, weights in schemes:
-        if method not in step_values or weights not in ("uniform", "cotan"):
-            raise MeshError(f"unknown scheme ({method!r}, {weights!r}); methods are 'explicit' and "
-                            "'implicit', weights 'uniform' and 'cotan'")
-    out = SmoothingSweep(sigmas, schemes, step_values, iterations)
-    where = {int(k): l for l, k in enumerate(iterations)}
-    edges = unique_edges(C.F)
-    last = int(iterations[-1])
-    runs = sum(len(step_values[m]) for m, _ in schemes) * len(out.sigmas)
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=runs, desc="smoothing sweep")
-    start = time.perf_counter()
-    try:
-        for i, sigma in enumerate(out.sigmas):
-            Vn = add_noise(C.V_clean, C.F, sigma, seed, direction=direction)
-            for key, value in C.evaluate(Vn, hausdorff=False).items():
-                out.noisy[key][i] = value
-            for j, (method, weights) in enumerate(schemes):
-                smoother = ImplicitSmoother(Vn, C.F, weights) if method == "implicit" else None
-                for k, value in enumerate(step_values[method]):
-                    step = scale_free_step(Vn, C.F, method, weights, value, edges)
-                    out.steps[i, j, k] = step
-
-                    def record(it, P, i=i, j=j, k=k):
-                        if it in where:
-                            for name, v in C.evaluate(P, hausdorff=False).items():
-                                out.values[name][i, j, k, where[it]] = v
-
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore", MeshWarning)
-                        if method == "explicit":
-                            explicit_smoothing(Vn, C.F, step, last, weights, callback=record,
-                                               on_failure="stop", progress=False)
-                        else:
-                            smoother.smooth(step, last, callback=record, progress=False)
-                    if bar is not None:
-                        bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
-    out.seconds = time.perf_counter() - start
-    return out

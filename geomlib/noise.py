@@ -1,58 +1,51 @@
-"""Seeded Gaussian noise on vertex positions, scaled to the mesh's size.
+"""Lesson (notebook 07): seeded Gaussian noise on vertex positions, scaled to the mesh's size.
 
-Convention: ``sigma`` is *relative to the bounding-box diagonal* of the input,
-so ``sigma=0.01`` displaces vertices by about 1 % of the mesh's diagonal
-whatever its units. The absolute standard deviation is
-``sigma * bounding_box_diagonal(V)`` (length units of the mesh).
-
-Randomness only through an explicit ``seed``: the same seed gives the same
-noise, bit for bit, and the input arrays are never modified.
+``sigma`` is relative to the bounding-box diagonal d of the input: ``sigma=0.01``
+moves vertices by about 1 % of the diagonal whatever the mesh's units; the
+absolute standard deviation is ``sigma * d`` (length units). Randomness only
+through an explicit ``seed``: the same seed gives the same noise, bit for bit,
+and the input arrays are never modified.
 """
 
 import numpy as np
 
 from .errors import MeshError
-from .metrics import bounding_box_diagonal
-from .validate import as_faces, as_vertices
+from .geometry import bounding_box_diagonal, vertex_normals
+from .validate import as_mesh
+
+__all__ = ["add_noise", "DIRECTIONS"]
 
 DIRECTIONS = ("isotropic", "normal")
 
 
 def add_noise(V, F, sigma, seed, direction="isotropic"):
-    """Vertex positions plus seeded Gaussian noise, ``sigma`` relative to the bounding-box diagonal.
+    """``V' = V + sigma d xi``: seeded Gaussian noise, sigma relative to the bounding-box diagonal d.
 
-    ``V' = V + s * xi`` with ``s = sigma * diag`` (``diag`` the bounding-box
-    diagonal of V, so ``s`` is in the mesh's length units):
-
-    * ``direction="isotropic"``: ``xi`` is an (n, 3) array of independent
-      standard normal numbers, so every coordinate of every vertex moves with
-      standard deviation ``s`` (the displacement length is ``s`` times a
-      chi distribution with 3 degrees of freedom, mean about ``1.60 s``).
-    * ``direction="normal"``: ``xi = z_i n_i`` with ``z_i`` standard normal and
-      ``n_i`` the area-weighted unit vertex normal of the *input* mesh, so the
-      signed normal displacement has standard deviation ``s`` and the noise
-      has no tangential part (a scanner's depth error). Isolated vertices
-      (no incident face) have no normal and do not move.
+    * ``direction="isotropic"``: ``xi`` is (n, 3) standard normal, so every
+      coordinate moves with standard deviation ``sigma d`` (the displacement
+      length has mean about ``1.60 sigma d``).
+    * ``direction="normal"``: ``xi_i = z_i n_i`` with ``z_i`` standard normal
+      and ``n_i`` the area-weighted unit vertex normal of the input: a
+      scanner's depth error, no tangential part. A vertex in no face has no
+      normal and does not move.
 
     Parameters
     ----------
     V : (n, 3) float64
-        Clean vertex positions (not modified).
+        Clean positions (not modified).
     F : (m, 3) int64
-        Triangles (only used for the normals; the connectivity is unchanged).
+        Triangles (only for the normals; the connectivity is unchanged).
     sigma : float
-        Noise level as a fraction of the bounding-box diagonal, ``>= 0``.
+        Noise level, a fraction of the bounding-box diagonal, ``>= 0``.
     seed : int or numpy.random.Generator
-        Seed of ``numpy.random.default_rng``; the same seed gives the same noise.
-    direction : "isotropic" or "normal"
+        Seed of ``numpy.random.default_rng``.
+    direction : {"isotropic", "normal"}
 
     Returns
     -------
-    (n, 3) float64
-        A new array; the input is never modified.
+    (n, 3) float64, a new array.
     """
-    V = as_vertices(V)
-    F = as_faces(F, len(V))
+    V, F = as_mesh(V, F)
     try:
         sigma = float(sigma)
     except (TypeError, ValueError):
@@ -67,7 +60,4 @@ def add_noise(V, F, sigma, seed, direction="isotropic"):
     s = sigma * bounding_box_diagonal(V)
     if direction == "isotropic":
         return V + s * rng.standard_normal(V.shape)
-    from .curvature import vertex_normals
-
-    N = vertex_normals(V, F)
-    return V + (s * rng.standard_normal(len(V)))[:, None] * N
+    return V + (s * rng.standard_normal(len(V)))[:, None] * vertex_normals(V, F)

@@ -49,6 +49,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from .errors import MeshError, format_indices
+from .geometry import face_cross
 
 __all__ = [
     "AnalyticMesh",
@@ -222,11 +223,6 @@ def _rng(seed):
 # ----------------------------------------------------------------------------
 
 
-def _face_normals(V, F):
-    """Unnormalised face normals (twice the area times the unit normal)."""
-    return np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-
-
 def _check_faces(V, F, D, what):
     """Raise MeshError on zero-area faces or faces that disagree with D.
 
@@ -235,7 +231,7 @@ def _check_faces(V, F, D, what):
     three vertices; this happens only when the jitter folds the tessellation
     over, and is reported rather than repaired.
     """
-    FN = _face_normals(V, F)
+    FN = face_cross(V, F)
     A2 = np.linalg.norm(FN, axis=1)
     scale = np.mean(np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1)) ** 2
     bad = np.flatnonzero(A2 <= 1e-12 * scale)
@@ -543,7 +539,7 @@ def _icosahedron():
                 if adj[i, k] and adj[j, k]:
                     F.append((i, j, k))
     F = np.array(F, dtype=np.int64)
-    flip = np.einsum("ij,ij->i", _face_normals(P, F), P[F].sum(axis=1)) < 0
+    flip = np.einsum("ij,ij->i", face_cross(P, F), P[F].sum(axis=1)) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
     return P, _canonical_faces(F)
 

@@ -32,6 +32,10 @@ __all__ = [
     "euler_characteristic",
     "connected_components",
     "vertex_face_adjacency",
+    "edge_face_counts",
+    "boundary_edge_counts",
+    "Topology",
+    "loops_from_edges",
 ]
 
 _INT64_MAX = np.iinfo(np.int64).max
@@ -57,8 +61,15 @@ def _sort_with_order(key):
     return key[order], order
 
 
-class _Topology:
-    """Half-edge bookkeeping shared by the functions below and check_mesh.
+class Topology:
+    """Half-edge table of a face array: the one edge table behind this module and check_mesh.
+
+    ``Topology(F, n)`` sorts the 3m half-edges once; its attributes are the
+    unique edges ``E`` (e, 2) (smaller index first, lexicographic),
+    ``edge_face_count`` (e,), ``vertex_face_count`` (n,), and the methods give
+    boundary edges, inconsistently oriented edges, non-manifold vertices,
+    vertex components and duplicate faces. ``F`` must be valid
+    (:func:`geomlib.validate.as_faces`).
 
     Half-edge ``h = 3 f + s`` runs from ``F[f, s]`` to ``F[f, (s + 1) % 3]``;
     corner ``3 f + s`` is the corner of face f at vertex ``F[f, s]`` (so a
@@ -100,6 +111,17 @@ class _Topology:
         p, h1, h2 = self._pairs()
         same = self.I[h1] == self.I[h2]
         return self.E[np.flatnonzero(self.edge_face_count == 2)[same]]
+
+    def face_pairs(self):
+        """Edges of exactly two faces that traverse them in opposite directions.
+
+        Returns ``E`` (k, 2), each edge ``(i, j)`` as face ``f1`` traverses
+        it, and ``f1``, ``f2`` (k,): the faces holding ``i -> j`` and ``j -> i``.
+        """
+        _, h1, h2 = self._pairs()
+        opposite = self.I[h1] == self.J[h2]
+        h1, h2 = h1[opposite], h2[opposite]
+        return np.stack([self.I[h1], self.J[h1]], axis=1), h1 // 3, h2 // 3
 
     def non_manifold_vertices(self):
         """Vertices whose faces form more than one fan, sorted.
@@ -241,8 +263,7 @@ def edges(F):
     -------
     E : (e, 2) int64
     """
-    F = as_faces(F)
-    return _Topology(F, _nverts(F, None)).E
+    return edge_face_counts(F)[0]
 
 
 def boundary_edges(F):
@@ -263,7 +284,7 @@ def boundary_edges(F):
         a closed mesh.
     """
     F = as_faces(F)
-    return _Topology(F, _nverts(F, None)).boundary_edges()
+    return Topology(F, _nverts(F, None)).boundary_edges()
 
 
 def boundary_vertices(F, n=None):
@@ -283,12 +304,10 @@ def boundary_vertices(F, n=None):
     -------
     (k,) int64
     """
-    F = as_faces(F, n)
-    B = _Topology(F, _nverts(F, n)).boundary_edges()
-    return np.unique(B)
+    return np.flatnonzero(boundary_edge_counts(F, n))
 
 
-def _loops_from_edges(B):
+def loops_from_edges(B):
     """Chain directed boundary edges into loops (see :func:`boundary_loops`)."""
     if len(B) == 0:
         return []
@@ -382,7 +401,7 @@ def boundary_loops(F):
     -------
     list of (k_i,) int64 arrays; empty for a closed mesh.
     """
-    return _loops_from_edges(boundary_edges(F))
+    return loops_from_edges(boundary_edges(F))
 
 
 def valence(F, n=None):
@@ -401,8 +420,7 @@ def valence(F, n=None):
     """
     F = as_faces(F, n)
     n = _nverts(F, n)
-    E = _Topology(F, n).E
-    return np.bincount(E.ravel(), minlength=n).astype(np.int64)
+    return np.bincount(edges(F).ravel(), minlength=n).astype(np.int64)
 
 
 def one_ring(F, i):
@@ -490,7 +508,7 @@ def euler_characteristic(V, F):
     int
     """
     V, F = as_mesh(V, F)
-    T = _Topology(F, len(V))
+    T = Topology(F, len(V))
     used = int(np.count_nonzero(T.vertex_face_count))
     return used - len(T.E) + len(F)
 
@@ -513,7 +531,7 @@ def connected_components(F, n=None):
     labels : (n,) int64
     """
     F = as_faces(F, n)
-    return _Topology(F, _nverts(F, n)).vertex_components()
+    return Topology(F, _nverts(F, n)).vertex_components()
 
 
 def vertex_face_adjacency(F, n=None):
@@ -528,3 +546,30 @@ def vertex_face_adjacency(F, n=None):
     return sp.csr_matrix(
         (np.ones(3 * m, np.int8), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m)
     )
+
+
+def edge_face_counts(F, n=None):
+    """Unique edges (e, 2) int64 (smaller index first, lexicographic) and the faces at each (e,) int64.
+
+    A counting sort by sparse assembly: the fast path when only the counts are
+    needed (curvature's boundary rule). O(n + m).
+    """
+    F = as_faces(F, n)
+    n = _nverts(F, n)
+    index = np.int32 if n < np.iinfo(np.int32).max else np.int64
+    I, J = F.ravel(), F[:, [1, 2, 0]].ravel()
+    lo, hi = np.minimum(I, J).astype(index), np.maximum(I, J).astype(index)
+    counts = sp.csr_matrix((np.ones(len(lo), np.int32), (lo, hi)), shape=(n, n))  # duplicates summed
+    counts.sort_indices()
+    rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(counts.indptr))
+    return np.stack([rows, counts.indices.astype(np.int64)], axis=1), counts.data.astype(np.int64)
+
+
+def boundary_edge_counts(F, n=None):
+    """Number of boundary edges (edges of exactly one face) at each vertex, (n,) int64.
+
+    0 at interior vertices, 2 at a simple boundary vertex, 2k where k open
+    fans meet (a non-manifold "bow-tie").
+    """
+    E, count = edge_face_counts(F, n)
+    return np.bincount(E[count == 1].ravel(), minlength=_nverts(np.asarray(F), n)).astype(np.int64)

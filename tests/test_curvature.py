@@ -344,3 +344,31 @@ def test_boundary_detection_ignores_orientation_flips():
     Fs[1::3] = Fs[1::3, ::-1]
     np.testing.assert_array_equal(boundary_mask(s.V, Fs), boundary_mask(s.V, s.F))
     assert boundary_mask(s.V, s.F).sum() == 4 * 9
+
+
+# ---------------------------------------------------------------- the teaching functions one by one
+
+def test_corner_angles_and_angle_deficit_against_libigl():
+    from geomlib.curvature import angle_deficit, corner_angles
+
+    V, F = surfaces.ellipsoid(1.0, 0.7, 0.5, 3).V, surfaces.ellipsoid(1.0, 0.7, 0.5, 3).F
+    np.testing.assert_allclose(corner_angles(V, F), igl.internal_angles(V, F), atol=1e-13)
+    np.testing.assert_allclose(angle_deficit(V, F), igl.gaussian_curvature(V, F), atol=1e-12)
+
+
+def test_corner_angles_of_a_3_4_5_triangle_and_a_collinear_one():
+    from geomlib.curvature import corner_angles
+
+    V = np.array([[0.0, 0, 0], [4, 0, 0], [0, 3, 0], [8, 0, 0]])
+    theta = corner_angles(V, [[0, 1, 2]])
+    np.testing.assert_allclose(theta, [[np.pi / 2, np.arctan2(3, 4), np.arctan2(4, 3)]], atol=1e-15)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)
+        flat = corner_angles(V, [[0, 1, 3]])          # zero area: pi opposite the longest edge (0, 3)
+    assert flat.tolist() == [[0.0, np.pi, 0.0]]
+
+
+def test_principal_curvatures_of_a_cylinder_point():
+    # cylinder of radius 2: H = 1/4, K = 0, so kappa_1 = 1/2 and kappa_2 = 0
+    k1, k2 = principal_curvatures(np.array([0.25]), np.array([0.0]))
+    assert k1.tolist() == [0.5] and k2.tolist() == [0.0]

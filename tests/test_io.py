@@ -13,7 +13,6 @@ import pytest
 import trimesh
 
 from geomlib import MeshError, MeshReport, MeshWarning, load_mesh, save_mesh
-from geomlib.io import _obj_fast, _obj_slow
 from meshdata import COURSE, needs_course
 
 
@@ -98,22 +97,56 @@ def test_obj_without_final_newline_and_tabs(tmp_path):
     assert len(V) == 3 and np.array_equal(F, [[0, 1, 2]])
 
 
-def test_fast_and_line_by_line_readers_agree(tmp_path):
+def test_interleaved_normals_and_texture_corners_keep_every_vertex(tmp_path):
     V, F = icosphere()
     rng = np.random.default_rng(0)
     V = V + 1e-3 * rng.standard_normal(V.shape)
     lines = ["# made for a test", "o ball"]
-    for k, p in enumerate(V):
+    for p in V:
         lines.append("v %.17g %.17g %.17g" % tuple(p))
         lines.append("vn 0 0 1")
+        lines.append("vt 0.5 0.5")
     for f in F + 1:
-        lines.append("f %d//1 %d//1 %d//1" % tuple(f))
-    data = ("\n".join(lines) + "\n").encode()
-    fast = _obj_fast(data)
-    slow = _obj_slow(data, "x.obj")
-    for k in (0, 1, 2, 3, 5):  # V, corner indices, polygon sizes, face lines, vertex lines
-        assert np.array_equal(fast[k], slow[k])
-    assert np.array_equal(fast[0], V)
+        lines.append("f %d/1/1 %d/1/1 %d/1/1" % tuple(f))
+    V2, F2 = load_quiet(write(tmp_path, "ball.obj", "\n".join(lines) + "\n"))
+    assert np.array_equal(V2, V) and np.array_equal(F2, F)
+
+
+def test_windows_scanner_file_loads_as_written(tmp_path):
+    # byte-order mark, CRLF, vertex colours, groups, objects, materials, smoothing groups, comments
+    V, F = icosphere()
+    colours = np.random.default_rng(1).uniform(0, 1, size=V.shape)
+    lines = ["# exported by a scanner", "mtllib scan.mtl", "o scan", "g body"]
+    lines += ["v %.17g %.17g %.17g %.3f %.3f %.3f" % (*p, *c) for p, c in zip(V, colours)]
+    lines += ["usemtl skin", "s 1"] + ["f %d %d %d" % tuple(f) for f in F + 1]
+    data = ("\ufeff" + "\r\n".join(lines) + "\r\n").encode("utf-8")
+    V2, F2 = load_quiet(write(tmp_path, "scan.obj", data))
+    assert np.array_equal(V2, V) and np.array_equal(F2, F)
+
+
+def test_bom_alone_and_classic_mac_line_ends(tmp_path):
+    V, F = load_quiet(write(tmp_path, "mac.obj", b"\xef\xbb\xbf" + (SQUARE_V + "f 1 2 3\nf 1 3 4").replace("\n", "\r").encode()))
+    assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]) and np.array_equal(F, [[0, 1, 2], [0, 2, 3]])
+
+
+def test_line_elements_are_ignored_with_a_count(tmp_path):
+    text = SQUARE_V + "l 1 2\nl 2 3 4\nf 1 2 3\nf 1 3 4\n"
+    with pytest.warns(MeshWarning, match=r"l\.obj: 2 line elements \('l' statements\) ignored") as rec:
+        V, F = load_mesh(write(tmp_path, "l.obj", text))
+    assert len(rec) == 1 and len(V) == 4 and np.array_equal(F, [[0, 1, 2], [0, 2, 3]])
+
+
+def test_awkward_scan_with_holes_loads_with_its_unused_vertices(tmp_path):
+    from awkward_meshes import scan_with_holes
+
+    path = scan_with_holes(tmp_path)
+    V, F, report = load_mesh(path, report=True)
+    written = path.read_bytes().decode("utf-8-sig").splitlines()
+    assert len(V) == sum(line.startswith("v ") for line in written)
+    assert len(F) == sum(line.startswith("f ") for line in written)
+    first = [float(x) for x in written[4].split()[1:4]]
+    assert V[0].tolist() == pytest.approx(first, abs=1e-9)
+    assert len(report.unreferenced_vertices) == 12 and report.n_boundary_loops == 3
 
 
 def test_unreferenced_vertex_is_kept_with_a_warning(tmp_path):

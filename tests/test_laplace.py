@@ -291,3 +291,67 @@ def test_libigl_course_meshes(name):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshWarning)
         _against_libigl(*load_mesh(COURSE / name))
+
+
+# ---------------------------------------------------------------- the teaching functions one by one
+
+from geomlib.laplace import (barycentric_areas, cotangent_matrix, face_geometry, mixed_areas,  # noqa: E402
+                             uniform_adjacency, uniform_laplacian)
+
+
+def test_face_geometry_of_a_3_4_5_triangle():
+    V = np.array([[0.0, 0, 0], [4, 0, 0], [0, 3, 0]])
+    l2, dblA, cot, degenerate = face_geometry(V, [[0, 1, 2]])
+    assert l2.tolist() == [[25.0, 9.0, 16.0]]          # opposite corners 0, 1, 2
+    assert dblA.tolist() == [12.0] and not degenerate[0]
+    np.testing.assert_allclose(cot, [[0.0, 4 / 3, 3 / 4]], atol=1e-15)   # right angle at 0; cot = adjacent / opposite
+
+
+def test_each_teaching_function_equals_the_dispatcher():
+    V, F = icosphere(2, scale=(1.0, 0.8, 0.6))
+    M, C = laplacian(V, F)
+    assert abs(cotangent_matrix(V, F) - C).max() == 0
+    assert np.array_equal(barycentric_areas(V, F), M.diagonal())
+    assert np.array_equal(mixed_areas(V, F), laplacian(V, F, area="mixed")[0].diagonal())
+    Mu, Cu = uniform_laplacian(V, F)
+    assert abs(Cu - laplacian(V, F, weights="uniform")[1]).max() == 0
+    A = uniform_adjacency(len(V), F)
+    assert A.nnz == 2 * (3 * len(F) // 2) and (A.data == 1).all()
+    np.testing.assert_array_equal(np.asarray(A.sum(axis=1)).ravel(), Mu.diagonal())
+
+
+def test_uniform_laplacian_of_a_tetrahedron_is_exact():
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    M, C = uniform_laplacian(V, F)
+    np.testing.assert_array_equal(dense(C), np.ones((4, 4)) - 4 * np.eye(4))
+    np.testing.assert_array_equal(M.diagonal(), [3, 3, 3, 3])
+
+
+def test_mixed_area_obtuse_cases_exact():
+    # one triangle obtuse at corner 2 (angle 120 degrees): A/4, A/4, A/2
+    V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, 1 / np.sqrt(3), 0]])
+    A = 1 / np.sqrt(3)
+    np.testing.assert_allclose(mixed_areas(V, [[0, 1, 2]]), [A / 4, A / 4, A / 2], rtol=1e-14)
+    # an equilateral triangle is all Voronoi: A/3 each
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]])
+    np.testing.assert_allclose(mixed_areas(V, [[0, 1, 2]]), np.full(3, np.sqrt(3) / 12), rtol=1e-14)
+
+
+def test_right_triangle_voronoi_meets_the_hypotenuse_midpoint():
+    # right angle at corner 0 (not obtuse): Voronoi parts 1/8 sum |e|^2 cot, summing to A
+    V = np.array([[0.0, 0, 0], [4, 0, 0], [0, 3, 0]])
+    a = mixed_areas(V, [[0, 1, 2]])
+    np.testing.assert_allclose(a, [3.0, (16 * 0.75 + 25 * 0) / 8, (9 * 4 / 3 + 25 * 0) / 8], rtol=1e-14)
+    assert a.sum() == pytest.approx(6.0, rel=1e-14)
+
+
+def test_teaching_functions_against_libigl_one_by_one():
+    igl = pytest.importorskip("igl")
+    V, F = icosphere(3, scale=(1.0, 0.7, 0.4))
+    scale = np.abs(igl.cotmatrix(V, F)).max()
+    assert abs(cotangent_matrix(V, F) - igl.cotmatrix(V, F)).max() < 1e-12 * scale
+    np.testing.assert_allclose(barycentric_areas(V, F),
+                               igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal(), rtol=1e-12)
+    np.testing.assert_allclose(mixed_areas(V, F), igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal(),
+                               rtol=1e-12)

@@ -352,7 +352,7 @@ SCHEMES = [("explicit", "uniform"), ("explicit", "cotan"), ("implicit", "uniform
 
 def smooth(V, F, method, weights, value, iterations):
     from geomlib import explicit_smoothing, implicit_smoothing
-    from geomlib.metrics import scale_free_step
+    from geomlib.sweep import scale_free_step
 
     step = scale_free_step(V, F, method, weights, value)
     run = explicit_smoothing if method == "explicit" else implicit_smoothing
@@ -391,7 +391,7 @@ def test_smoothing_a_clean_sphere_only_shrinks_it(method, weights):
 
 
 def test_sweep_records_what_a_direct_run_gives():
-    from geomlib.metrics import smoothing_sweep
+    from geomlib.sweep import smoothing_sweep
 
     V, F = icosphere(2)
     R = smoothing_sweep(V, F, [0.002, 0.01], seed=3, explicit_fractions=(0.25, 0.5),

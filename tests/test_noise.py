@@ -88,3 +88,19 @@ def test_bad_mesh_raises_mesh_error_naming_the_faces():
         add_noise(V, np.array([[0, 1, 2], [0, 1, 5]]), 0.1, seed=0)
     with pytest.raises(MeshError, match="vertices 1"):
         add_noise(np.array([[0, 0, 0], [np.nan, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]]), 0.1, seed=0)
+
+
+def test_normal_noise_moves_along_the_geometry_vertex_normals():
+    from geomlib.geometry import vertex_normals
+
+    V, F = _sphere()
+    W = add_noise(V, F, 0.01, seed=4, direction="normal")
+    D = W - V
+    N = vertex_normals(V, F)
+    np.testing.assert_allclose(np.linalg.norm(np.cross(D, N), axis=1), 0, atol=1e-15)
+
+
+def _sphere():
+    from geomlib.surfaces import icosphere as ico
+
+    return ico(2)

@@ -299,3 +299,18 @@ def test_loop_chaining_vectorised_matches_walk():
     assert _loops_vectorised(boundary_edges(bow)) is None
     loops = boundary_loops(bow)
     assert sorted(len(l) for l in loops) == [3, 3]
+
+
+def test_edge_face_counts_boundary_counts_and_face_pairs():
+    from geomlib.topology import Topology, boundary_edge_counts, edge_face_counts
+
+    # a square of two triangles, and a third triangle on edge (0, 1) below it
+    F = np.array([[0, 1, 2], [0, 2, 3], [1, 0, 4]])
+    E, count = edge_face_counts(F)
+    assert E.tolist() == [[0, 1], [0, 2], [0, 3], [0, 4], [1, 2], [1, 4], [2, 3]]
+    assert count.tolist() == [2, 2, 1, 1, 1, 1, 1]
+    assert boundary_edge_counts(F).tolist() == [2, 2, 2, 2, 2]
+    E2, f1, f2 = Topology(F, 5).face_pairs()
+    assert E2.tolist() == [[0, 1], [2, 0]] and f1.tolist() == [0, 0] and f2.tolist() == [2, 1]
+    # a bow-tie vertex has four boundary edges
+    assert boundary_edge_counts(np.array([[0, 1, 2], [0, 3, 4]]))[0] == 4

@@ -260,3 +260,21 @@ def test_camel_has_exactly_one_non_manifold_vertex():
 def test_course_boundary_loops(name, loops):
     r = load_mesh(COURSE / name, report=True)[2]
     assert r.boundary_loop_lengths == loops and r.ok and r.genus == 0
+
+
+def test_is_zero_area_is_scale_free_and_zero_area_faces_uses_it():
+    from geomlib.validate import is_zero_area, zero_area_faces
+
+    assert is_zero_area(np.array([0.0, 1e-13, 1e-11]), np.ones(3)).tolist() == [True, True, False]
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1e-14, 0]])
+    F = np.array([[0, 1, 3], [0, 1, 2], [0, 2, 4]])
+    assert zero_area_faces(V, F).tolist() == [1, 2]
+    assert zero_area_faces(1e6 * V, F).tolist() == [1, 2]
+
+
+def test_check_mesh_lives_in_report_and_validate_does_not_import_topology():
+    import geomlib.report
+    import geomlib.validate
+
+    assert geomlib.check_mesh is geomlib.report.check_mesh
+    assert "topology" not in open(geomlib.validate.__file__).read()
