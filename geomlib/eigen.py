@@ -74,7 +74,8 @@ def smallest_eigenpairs(S, k, shift, method="auto", tol=0.0):
     with one_blas_thread():
         if dense:
             A = S.toarray()
-            return la.eigh(0.5 * (A + A.T), subset_by_index=[0, k - 1], driver="evr" if k < n else "evd")
+            A = 0.5 * (A + A.T)
+            return la.eigh(A, subset_by_index=[0, k - 1], driver="evr") if k < n else la.eigh(A, driver="evd")
         with Stages(["factorising", "Lanczos iterations"], solve_seconds(n, k), f"{k} eigenpairs") as bar:
             shifted = factorise(S + shift * sp.eye(n, format="csr"))
             bar.next()
