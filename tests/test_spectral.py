@@ -474,3 +474,16 @@ def test_blas_thread_setting_is_restored(egg):
         assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")
     eigenbasis(*egg, 5, cache=False)
     assert [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"] == before
+
+
+def test_long_solves_show_their_stages(egg_fine, monkeypatch, capsys):
+    import geomlib.progress as progress
+
+    V, F = egg_fine
+    monkeypatch.setattr(progress, "SECONDS", -1.0)  # every solve counts as long
+    eigenbasis(V, F, 20, cache=False, method="sparse")
+    err = capsys.readouterr().err
+    assert "20 eigenpairs (about" in err and "factorising" in err
+    monkeypatch.setattr(progress, "SECONDS", 1e9)  # none does
+    eigenbasis(V, F, 20, cache=False, method="sparse")
+    assert capsys.readouterr().err == ""
