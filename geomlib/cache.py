@@ -26,7 +26,7 @@ import numpy as np
 
 from .errors import MeshWarning
 
-__all__ = ["CACHE_DIR", "MEMORY_SIZE", "folder", "key", "clear", "remember", "recall", "load", "store"]
+__all__ = ["CACHE_DIR", "MEMORY_SIZE", "folder", "key", "clear", "forget", "remember", "recall", "load", "store"]
 
 #: Cache folder chosen by the user for this session (None: see :func:`folder`).
 CACHE_DIR = None
@@ -86,6 +86,11 @@ def clear(cache_dir=None, memory=True):
             except OSError:
                 pass
     return removed
+
+
+def forget():
+    """Empty the memory cache only (as a restarted kernel finds it)."""
+    _MEMORY.clear()
 
 
 def remember(name, value):

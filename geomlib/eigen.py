@@ -7,6 +7,15 @@
   (:mod:`geomlib.factor`) computed once.
 * :func:`largest_eigenpair` -- the largest eigenpair, by ARPACK without any
   factorisation (only products with S are needed).
+* :func:`largest_eigenvalue` -- the largest eigenvalue alone, by a plain
+  Lanczos iteration written here. Kept because no library call reached the
+  speed the explicit step limit needs: measured on a 40,962-vertex icosphere
+  (2 cores, one BLAS thread), the uniform operator, whose top eigenvalues form
+  a tight cluster, took 1.6 s with it against 6.3 s with ARPACK (``eigsh``,
+  ``which="LA"``, tol 1e-6; 13.8 s at tol 1e-8) and 120 s with ``lobpcg``;
+  for the cotan operator 0.18 s against 0.27 s. ARPACK waits for the residual
+  of the eigenvector, which converges slowly inside a cluster; the extreme
+  Ritz value itself converges fast, and that is all the limit needs.
 
 Both run with one BLAS thread (``threadpoolctl``): on 2-core machines shared
 with other busy processes, a 2-thread BLAS pool made dense ``eigh`` at 642
@@ -23,7 +32,8 @@ from threadpoolctl import ThreadpoolController
 from .factor import factor_seconds, factorise
 from .progress import Stages
 
-__all__ = ["DENSE_MAX", "smallest_eigenpairs", "largest_eigenpair", "one_blas_thread", "solve_seconds"]
+__all__ = ["DENSE_MAX", "smallest_eigenpairs", "largest_eigenpair", "largest_eigenvalue", "one_blas_thread",
+           "solve_seconds"]
 
 #: Matrices of at most this size are solved with dense LAPACK.
 DENSE_MAX = 600
@@ -101,3 +111,39 @@ def largest_eigenpair(S, tol=1e-8):
         v0 = np.random.default_rng(0).standard_normal(n)
         lam, Y = sla.eigsh(S, k=1, which="LA", v0=v0, tol=tol, ncv=min(n - 1, 40))
     return float(lam[0]), Y[:, 0]
+
+
+def largest_eigenvalue(S, rtol=1e-8, maxiter=500):
+    """The largest eigenvalue of a sparse symmetric S (n, n) by plain Lanczos (module docstring).
+
+    The largest Ritz value approaches it from below (so a step limit ``2 / lam``
+    is never underestimated); the iteration stops when that value changes by
+    less than ``rtol`` (relative) over ten steps. Extreme Ritz values stay
+    accurate without re-orthogonalisation, and a cluster of near-equal top
+    eigenvalues gives the largest to within the cluster's width. A fixed start
+    vector makes the result reproducible. Dense LAPACK up to ``DENSE_MAX`` rows.
+    """
+    n = S.shape[0]
+    if n <= DENSE_MAX:
+        with one_blas_thread():
+            return float(np.linalg.eigvalsh(S.toarray())[-1])
+    q = np.random.default_rng(0).standard_normal(n)
+    q /= np.sqrt(q @ q)
+    q_prev, beta = np.zeros(n), 0.0
+    alphas, betas, history = [], [], []
+    for j in range(min(maxiter, n)):
+        w = S @ q - beta * q_prev
+        alpha = float(q @ w)
+        w -= alpha * q
+        alphas.append(alpha)
+        beta = float(np.sqrt(w @ w))
+        last = j == min(maxiter, n) - 1 or beta <= 1e-14 * abs(alpha)
+        if j % 5 == 4 or last:  # the top eigenvalue of the tridiagonal matrix T_j
+            theta = la.eigvalsh_tridiagonal(np.array(alphas), np.array(betas), select="i",
+                                            select_range=(j, j))[0]
+            history.append(theta)
+            if last or (len(history) > 2 and history[-1] - history[-3] <= rtol * abs(theta)):
+                return float(theta)
+        betas.append(beta)
+        q_prev, q = q, w / beta
+    return float(history[-1])

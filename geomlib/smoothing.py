@@ -38,7 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .eigen import largest_eigenpair
+from .eigen import largest_eigenpair, largest_eigenvalue
 from .errors import MeshError, MeshWarning, format_indices
 from .factor import factor_seconds, factorise
 from .geometry import bounding_box_diagonal, surface_area
@@ -112,14 +112,21 @@ def explicit_step_limit(V, F, weights="cotan", area="barycentric", boundary="fix
     -------
     float
         In length^2 (cotan) or dimensionless (uniform); ``inf`` when no vertex
-        can move. ``lam_max`` comes from :func:`highest_frequency_mode`
-        (cached per mesh and options, so repeated calls are cheap).
+        can move. ``lam_max`` is the largest eigenvalue of
+        ``S = -M^-1/2 C M^-1/2`` on the moving vertices (the spectrum of
+        ``-Delta``), by :func:`geomlib.eigen.largest_eigenvalue` (relative
+        accuracy about 1e-8, from below, so the limit is never underestimated).
+        Cached per mesh and options, so a slider calls it for free.
     """
-    lam_max, _ = highest_frequency_mode(V, F, weights, area, boundary)
-    return 2.0 / lam_max if lam_max > 0 else float("inf")
-
-
-_MODES = {}
+    V, F = as_mesh(V, F)
+    _check_choice(weights, "weights", _WEIGHTS)
+    _check_choice(boundary, "boundary", _BOUNDARY)
+    name = ("limit", V.tobytes(), F.tobytes(), weights, area, boundary)
+    if name not in _REMEMBERED:
+        I, m, S = _moving_block(V, F, weights, area, boundary, "explicit_step_limit")
+        lam_max = largest_eigenvalue(S) if len(I) else 0.0
+        _remember(name, 2.0 / lam_max if lam_max > 0 else float("inf"))
+    return _REMEMBERED[name]
 
 
 def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="fixed"):
@@ -130,7 +137,7 @@ def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="
     interior vertices (boundary values held at zero), the operator the explicit
     scheme iterates. Solved in the symmetric form ``S y = lam y``,
     ``S = -M^-1/2 C M^-1/2`` on the moving vertices, ``e = M^-1/2 y``
-    (:func:`geomlib.eigen.largest_eigenpair`, relative accuracy 1e-8, from below).
+    (:func:`geomlib.eigen.largest_eigenpair`, ARPACK, relative accuracy 1e-8).
 
     Returns
     -------
@@ -143,23 +150,35 @@ def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="
     V, F = as_mesh(V, F)
     _check_choice(weights, "weights", _WEIGHTS)
     _check_choice(boundary, "boundary", _BOUNDARY)
-    name = (V.tobytes(), F.tobytes(), weights, area, boundary)
-    if name not in _MODES:
-        M, C = laplacian(V, F, weights=weights, area=area)
-        m = positive_vertex_areas(M, F, "highest_frequency_mode")
-        I = np.flatnonzero(_moving(F, len(V), boundary))
-        D_inv = sp.diags(1.0 / np.sqrt(m[I]))                 # M^-1/2 on the moving vertices
-        S = (D_inv @ (-C.tocsr()[I][:, I]) @ D_inv).tocsr()  # symmetric PSD, spectrum of -Delta
+    name = ("mode", V.tobytes(), F.tobytes(), weights, area, boundary)
+    if name not in _REMEMBERED:
+        I, m, S = _moving_block(V, F, weights, area, boundary, "highest_frequency_mode")
         lam_max, y = largest_eigenpair(S) if len(I) else (0.0, np.zeros(0))
         e = np.zeros(len(V))
         e[I] = y / np.sqrt(m[I])                              # e = M^-1/2 y, e^T M e = 1
         if len(I) and e[np.argmax(np.abs(e))] < 0:
             e = -e
-        while len(_MODES) >= 16:
-            _MODES.pop(next(iter(_MODES)))
-        _MODES[name] = (lam_max, e)
-    lam_max, e = _MODES[name]
+        _remember(name, (lam_max, e))
+    lam_max, e = _REMEMBERED[name]
     return lam_max, e.copy()
+
+
+_REMEMBERED = {}
+
+
+def _remember(name, value, size=16):
+    while len(_REMEMBERED) >= size:
+        _REMEMBERED.pop(next(iter(_REMEMBERED)))
+    _REMEMBERED[name] = value
+
+
+def _moving_block(V, F, weights, area, boundary, what):
+    """Moving vertices I, vertex areas m and ``S = -M^-1/2 C M^-1/2`` restricted to I."""
+    M, C = laplacian(V, F, weights=weights, area=area)
+    m = positive_vertex_areas(M, F, what)
+    I = np.flatnonzero(_moving(F, len(V), boundary))
+    D_inv = sp.diags(1.0 / np.sqrt(m[I]))                     # M^-1/2 on the moving vertices
+    return I, m, (D_inv @ (-C.tocsr()[I][:, I]) @ D_inv).tocsr()
 
 
 # --------------------------------------------------------------------------
