@@ -43,8 +43,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import geomlib  # noqa: E402
 import geomlib.cache as basis_cache  # noqa: E402
-from geomlib.eigen import one_blas_thread  # noqa: E402
 from geomlib import eigenbasis, laplacian, spectral_reconstruction  # noqa: E402
+from geomlib.eigen import one_blas_thread  # noqa: E402
 from geomlib.surfaces import icosphere, torus  # noqa: E402
 
 CASES = [(5, 50), (5, 200), (6, 50), (6, 200), (7, 50)]  # (icosphere subdivisions, k)

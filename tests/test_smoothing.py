@@ -1,20 +1,17 @@
 """Laws of explicit and implicit Laplacian smoothing (geomlib.smoothing)."""
 
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 import trimesh
-
-from geomlib import (MeshError, MeshWarning, explicit_smoothing, explicit_step_limit,
-                     implicit_smoothing, laplacian)
-from geomlib.smoothing import explicit_step, implicit_step
-from geomlib.smoothing import ImplicitSmoother, _volume_centroid, highest_frequency_mode
-from geomlib.topology import boundary_vertices
 from meshdata import COURSE
+
+from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_limit, implicit_smoothing, laplacian
+from geomlib.smoothing import ImplicitSmoother, _volume_centroid, explicit_step, highest_frequency_mode, implicit_step
+from geomlib.topology import boundary_vertices
 
 
 def _boundary_mask(F, n):

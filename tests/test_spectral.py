@@ -2,10 +2,10 @@
 
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from meshdata import COURSE
 
 import geomlib
 import geomlib.cache as basis_cache
@@ -21,7 +21,6 @@ from geomlib import (
     spectral_reconstruction,
 )
 from geomlib.surfaces import ellipsoid, icosphere, sphere
-from meshdata import COURSE
 
 
 @pytest.fixture(autouse=True)
