@@ -5,12 +5,14 @@ One call, :func:`factorise`, returns an object whose ``solve(B)`` returns
 (Chen, Davis, Hager and Rajamanickam 2008) through the ``cholespy`` binding,
 which ships CHOLMOD with its own fill-reducing ordering inside its wheels.
 CHOLMOD chooses the elimination order itself, so no ordering is written here.
+The wheels link the reference (single-threaded) BLAS, so a factorisation uses
+one core and does not compete with a BLAS thread pool on 2-core machines.
 
 Why not scipy's ``splu``: the matrices here (``M - tau C`` of implicit
 smoothing, ``S + s I`` of the shift-invert eigensolver) are symmetric positive
 definite, and SuperLU treats them as general matrices with a column ordering.
 Measured on icospheres on a 2-core machine (``M - 10 h^2 C``, three
-right-hand sides):
+right-hand sides; load average about 3):
 
 =========  ==================  ==================
 vertices   cholespy            splu (COLAMD)

@@ -609,7 +609,7 @@ def implicit_smoothing(V, F, step, iterations=1, weights="cotan", *, area="baryc
             return V.copy()
         factor = smoother.factor(step) if solver == "lu" else None
         advance = (lambda P: smoother.step_once(P, step, factor)) if factor else _cg_steps(smoother, step)
-    P, area0 = V.copy(), surface_area(V, F)
+    P, area0 = V.copy(), surface_area(V, F) if rebuild else None
     bar = Iterations(iterations, progress, "implicit smoothing")
     try:
         for k in range(1, iterations + 1):
