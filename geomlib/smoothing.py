@@ -398,16 +398,23 @@ class ImplicitSmoother:
     def prepare(self, steps, iterations=0, keep_volume=False):
         """Factorise for every step value in ``steps`` now (e.g. all positions of a slider),
         and with ``iterations > 0`` also compute and keep that many iterates of each, so
-        that a slider callback only looks them up. Grows both caches to hold them all."""
+        that a slider callback only looks them up. Grows both caches to hold them all.
+        Shows a progress bar when the first step value predicts more than
+        ``geomlib.progress.SECONDS`` in all."""
         steps = [_check_step(s) for s in steps]
         iterations = _check_iterations(iterations)
         self.cache_size = max(self.cache_size, len(steps))
         if iterations:
             self.history_size = max(self.history_size, len(steps))
-        for s in steps:
-            self.factor(s)
-            if iterations:
-                self.smooth(s, iterations, keep_volume=keep_volume, progress=False)
+        bar = Iterations(len(steps), None, "factorising the step values")
+        try:
+            for j, s in enumerate(steps, 1):
+                self.factor(s)
+                if iterations:
+                    self.smooth(s, iterations, keep_volume=keep_volume, progress=False)
+                bar.step(j)
+        finally:
+            bar.close()
         return self
 
     def step_once(self, P, step, factor=None):

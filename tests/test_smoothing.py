@@ -488,3 +488,12 @@ def test_prepare_factorises_and_keeps_iterates():
     for s in steps:
         np.testing.assert_allclose(S.smooth(s, 3), implicit_smoothing(V, F, s, 3), atol=1e-14)
         np.testing.assert_allclose(S.smooth(s, 4), implicit_smoothing(V, F, s, 4), atol=1e-14)
+
+
+def test_prepare_shows_progress_when_long(monkeypatch, capsys):
+    from geomlib import progress
+
+    V, F = icosphere(2)
+    monkeypatch.setattr(progress, "SECONDS", 0.0)
+    ImplicitSmoother(V, F).prepare([0.01, 0.1, 1.0], iterations=2)
+    assert "factorising the step values" in capsys.readouterr().err
