@@ -11,8 +11,8 @@ What is timed (wall clock, the same run, alternating, best of ``--repeat``):
 
 * ``implicit_smoothing(V, F, step, 10)`` with the operator kept fixed (cotan
   weights, barycentric areas): the operator is built once, ``M - step C`` is
-  factorised once (scipy ``splu``) and the factorisation solves the 10
-  iterations.
+  factorised once (sparse Cholesky, CHOLMOD through cholespy:
+  ``geomlib.factor``) and the factorisation solves the 10 iterations.
 * the baseline: the same operator built once (``geomlib.laplacian``), then
   ``scipy.sparse.linalg.spsolve(M - step C, M P)`` called every iteration, 10
   times, as a straightforward implementation does.
@@ -23,6 +23,11 @@ vertices) with seeded Gaussian noise of 0.2 mean edge lengths along the normal;
 the step is 10 mean edge lengths squared (scale-free value 10). The results of
 ours and the baseline are compared (max difference printed). Target: ratio at
 most 0.2 at 160k vertices.
+
+Step limit (``--limit``): ``explicit_step_limit`` for cotan and uniform
+weights on the 25,000-vertex torus and the 163,842-vertex icosphere, first
+call and cached call (what notebook 05's sliders pay), against scipy's
+``eigsh(S, k=1, which="LA", tol=1e-8)`` on the same symmetric matrix.
 
 Slider: the callback behind notebook 06's step and iteration sliders on a
 25,000-vertex torus (200 x 125 sections), and on the course's 25,193-vertex
@@ -186,18 +191,42 @@ def bench_slider(repeat):
               f"a step never factorised {t_cold * 1e3:.0f} ms", flush=True)
 
 
+def bench_limit():
+    """explicit_step_limit, first and cached call, against ARPACK on the same matrix."""
+    import scipy.sparse as sp
+
+    from geomlib import explicit_step_limit, laplacian
+
+    meshes = [next(slider_meshes()), ("icosphere",) + noisy_icosphere(7)[:2]]
+    for name, V, F in meshes:
+        for weights in ("cotan", "uniform"):
+            t_first, limit = timed(explicit_step_limit, V, F, weights, boundary="free")
+            t_cached, _ = timed(explicit_step_limit, V, F, weights, boundary="free")
+            M, C = laplacian(V, F, weights=weights)
+            d = sp.diags(1.0 / np.sqrt(M.diagonal()))
+            S = (d @ (-C) @ d).tocsr()
+            v0 = np.random.default_rng(0).standard_normal(len(V))
+            t_ref, lam = timed(sla.eigsh, S, k=1, which="LA", v0=v0, tol=1e-8)
+            print(f"step limit, {name} {len(V):,d} vertices, {weights}: first call {t_first:.2f} s, "
+                  f"cached {t_cached * 1e3:.2f} ms; eigsh {t_ref:.2f} s; ratio {t_first / t_ref:.2f}; "
+                  f"2 / lam_max agree to {abs(limit * lam[0][0] / 2 - 1):.1e}", flush=True)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--levels", type=int, nargs="+", default=[6, 7, 8])
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--cg", action="store_true", help="also time solver='cg'")
     parser.add_argument("--no-slider", action="store_true")
+    parser.add_argument("--limit", action="store_true", help="also time explicit_step_limit")
     args = parser.parse_args()
     print(f"implicit smoothing, {ITERATIONS} iterations, operator fixed, step = "
           f"{STEP_SCALE_FREE:g} mean edge length^2; ratio = ours / spsolve every iteration")
     bench_sizes(args.levels, args.repeat, args.cg)
     if not args.no_slider:
         bench_slider(max(args.repeat, 3))
+    if args.limit:
+        bench_limit()
 
 
 if __name__ == "__main__":

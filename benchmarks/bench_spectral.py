@@ -13,7 +13,7 @@ problem ``-C e = lam M e``:
 the same tiny shift ``s`` that geomlib uses. geomlib is timed with
 ``cache=False`` (a cold solve). Ratios are geomlib / reference: below 1 means
 geomlib is faster. geomlib runs its solver with one BLAS thread
-(``geomlib.spectral.BLAS_THREADS``); the reference is timed twice, with the
+(``geomlib.eigen.one_blas_thread``); the reference is timed twice, with the
 BLAS library's default thread count and with one thread, so the table shows
 what comes from the algorithm and what from avoiding thread contention.
 Runs alternate between the two solvers, after a warm-up on a small mesh; the
@@ -42,8 +42,9 @@ import scipy.sparse.linalg as sla
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import geomlib  # noqa: E402
-import geomlib.spectral as spectral  # noqa: E402
+import geomlib.cache as basis_cache  # noqa: E402
 from geomlib import eigenbasis, laplacian, spectral_reconstruction  # noqa: E402
+from geomlib.eigen import one_blas_thread  # noqa: E402
 from geomlib.surfaces import icosphere, torus  # noqa: E402
 
 CASES = [(5, 50), (5, 200), (6, 50), (6, 200), (7, 50)]  # (icosphere subdivisions, k)
@@ -59,7 +60,7 @@ def bumpy_mesh(subdivisions):
 
 def reference(V, F, k):
     M, C = laplacian(V, F)
-    s = spectral._shift(M.diagonal(), C)
+    s = 1e-4 * 4.0 * np.pi / M.diagonal().sum()  # the shift geomlib.eigenbasis uses
     lam = sla.eigsh((-C).tocsc(), k=k, M=M.tocsc(), sigma=-s, which="LM", return_eigenvectors=True)[0]
     return np.sort(lam)
 
@@ -85,7 +86,7 @@ def bench_eigenbasis(cases, repeat):
             t_ref.append(t)
             t, (lam, _) = timed(eigenbasis, V, F, k, cache=False)
             t_geo.append(t)
-            with spectral._blas_threads(1):
+            with one_blas_thread():
                 t, _ = timed(reference, V, F, k)
             t_ref1.append(t)
         rel = np.abs(lam[1:] - lam_ref[1:]) / lam_ref[1:]
@@ -105,14 +106,14 @@ def bench_cache_and_slider(k=200):
     n = len(V)
     with tempfile.TemporaryDirectory() as folder:
         cold, _ = timed(eigenbasis, V, F, k, cache_dir=folder)
-        spectral._MEMORY.clear()  # as after a kernel restart
+        basis_cache.forget()  # as after a kernel restart
         warm_disk, (lam, E) = timed(eigenbasis, V, F, k, cache_dir=folder)
         warm_memory, _ = timed(eigenbasis, V, F, k, cache_dir=folder)
         times = []
         for kk in np.linspace(1, k, 40).astype(int):
             dt, _ = timed(spectral_reconstruction, V, F, int(kk), cache_dir=folder)
             times.append(dt)
-    spectral._MEMORY.clear()
+    basis_cache.forget()
     out = dict(vertices=n, k=k, cold_s=cold, warm_cache_s=warm_disk, memory_s=warm_memory,
                slider_ms_median=1e3 * float(np.median(times)), slider_ms_max=1e3 * float(np.max(times)))
     print(f"cache, {n} vertices, k = {k}: cold {cold:.2f} s, warm from disk {warm_disk:.3f} s, "

@@ -1,19 +1,23 @@
 """Laws of explicit and implicit Laplacian smoothing (geomlib.smoothing)."""
 
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 import trimesh
-
-from geomlib import (MeshError, MeshWarning, explicit_smoothing, explicit_step_limit,
-                     implicit_smoothing, laplacian)
-from geomlib.smoothing import (ImplicitSmoother, _boundary_mask, _volume_centroid,
-                               highest_frequency_mode)
 from meshdata import COURSE
+
+from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_limit, implicit_smoothing, laplacian
+from geomlib.smoothing import ImplicitSmoother, _volume_centroid, explicit_step, highest_frequency_mode, implicit_step
+from geomlib.topology import boundary_vertices
+
+
+def _boundary_mask(F, n):
+    mask = np.zeros(n, dtype=bool)
+    mask[boundary_vertices(F, n)] = True
+    return mask
 
 
 def icosphere(subdivisions=2, radius=1.0, centre=(0.0, 0.0, 0.0)):
@@ -385,18 +389,66 @@ def test_course_noisy_plane():
     assert roughness(Q) < 0.5 * roughness(V)
 
 
-def test_nested_dissection_order_solves_exactly():
-    from geomlib.smoothing import NESTED_DISSECTION_MIN, _nested_dissection
-
-    V, F = icosphere(5)  # 10242 vertices: the reordered factorisation is used
-    assert len(V) > NESTED_DISSECTION_MIN
+def test_cholesky_factorisation_solves_exactly():
+    V, F = icosphere(5)  # 10242 vertices
     V = V + 0.01 * np.random.default_rng(10).standard_normal(V.shape)
     M, C = laplacian(V, F)
-    p = _nested_dissection(V, C)
-    assert np.array_equal(np.sort(p), np.arange(len(V)))
     step = 0.001
     P = sla.spsolve((M - step * C).tocsc(), M @ V)
     np.testing.assert_allclose(implicit_smoothing(V, F, step, 1), P, rtol=0, atol=1e-10)
+
+
+def test_the_formulas_are_one_step_of_the_smoothers():
+    V, F = icosphere(2)
+    V = V + 0.02 * np.random.default_rng(3).standard_normal(V.shape)
+    M, C = laplacian(V, F)
+    tau = 0.5 * explicit_step_limit(V, F)
+    np.testing.assert_allclose(explicit_step(V, M, C, tau),
+                               V + tau * sp.diags(1 / M.diagonal()) @ (C @ V), atol=1e-14)
+    np.testing.assert_allclose(explicit_step(V, M, C, tau), explicit_smoothing(V, F, tau, 1), atol=1e-13)
+    P = implicit_step(V, M, C, 10 * tau)
+    np.testing.assert_allclose((M - 10 * tau * C) @ P, M @ V, atol=1e-12)
+    np.testing.assert_allclose(P, implicit_smoothing(V, F, 10 * tau, 1), atol=1e-12)
+
+
+def test_not_positive_definite_is_a_clear_error():
+    from geomlib.factor import factorise
+
+    with pytest.raises(np.linalg.LinAlgError, match="not positive definite"):
+        factorise(sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]])))
+
+
+@pytest.mark.parametrize("call", [
+    lambda V, F: explicit_smoothing(V, F, 1e-4, 2),
+    lambda V, F: explicit_step_limit(V, F),
+    lambda V, F: implicit_smoothing(V, F, 1e-3, 2),
+    lambda V, F: implicit_smoothing(V, F, 1e-3, 2, rebuild=True),
+    lambda V, F: ImplicitSmoother(V, F),
+])
+def test_unused_vertices_are_named_never_nan(call):
+    V, F = icosphere(1)
+    V2 = np.vstack([V, [[3.0, 0.0, 0.0]], V[:2] + 5.0])  # vertices 42, 43, 44 used by no face
+    with pytest.raises(MeshError, match=r"3 vertices are used by no face \(42, 43, 44\).*"
+                                        r"remove_unreferenced_vertices\(V, F\)"):
+        call(V2, F)
+
+
+def test_unused_vertices_in_the_step_formulas():
+    V, F = icosphere(1)
+    V2 = np.vstack([V, [[3.0, 0.0, 0.0]]])
+    M, C = laplacian(V2, F)
+    for step in (explicit_step, implicit_step):
+        with pytest.raises(MeshError, match="zero at 1 of 43 vertices"):
+            step(V2, M, C, 1e-3)
+
+
+def test_several_components_smooth_independently():
+    V, F = icosphere(2)
+    V2 = np.vstack([V, V + [5.0, 0.0, 0.0]])
+    F2 = np.vstack([F, F + len(V)])
+    P = implicit_smoothing(V2, F2, 0.01, 3)
+    np.testing.assert_allclose(P[:len(V)], implicit_smoothing(V, F, 0.01, 3), atol=1e-12)
+    np.testing.assert_allclose(P[len(V):], implicit_smoothing(V, F, 0.01, 3) + [5.0, 0.0, 0.0], atol=1e-12)
 
 
 def test_smoother_history_matches_fresh_runs():
@@ -416,13 +468,13 @@ def test_smoother_history_matches_fresh_runs():
 
 
 def test_progress_bar_appears_for_long_runs(monkeypatch, capsys):
-    import geomlib.smoothing as smoothing
+    import geomlib.progress as progress
 
     V, F = icosphere(2)
-    monkeypatch.setattr(smoothing, "PROGRESS_SECONDS", 0.0)  # every run counts as long
+    monkeypatch.setattr(progress, "SECONDS", 0.0)  # every run counts as long
     implicit_smoothing(V, F, 0.01, 3)
     assert "implicit smoothing" in capsys.readouterr().err
-    monkeypatch.setattr(smoothing, "PROGRESS_SECONDS", 1e9)  # no run does
+    monkeypatch.setattr(progress, "SECONDS", 1e9)  # no run does
     explicit_smoothing(V, F, 1e-4, 3)
     assert capsys.readouterr().err == ""
 
@@ -432,7 +484,16 @@ def test_prepare_factorises_and_keeps_iterates():
     V = V + 0.02 * np.random.default_rng(12).standard_normal(V.shape)
     steps = [0.01, 0.1, 1.0]
     S = ImplicitSmoother(V, F, cache_size=1, history_size=1).prepare(steps, iterations=3)
-    assert len(S._lu) == 3 and len(S._history) == 3
+    assert len(S._factors) == 3 and len(S._history) == 3
     for s in steps:
         np.testing.assert_allclose(S.smooth(s, 3), implicit_smoothing(V, F, s, 3), atol=1e-14)
         np.testing.assert_allclose(S.smooth(s, 4), implicit_smoothing(V, F, s, 4), atol=1e-14)
+
+
+def test_prepare_shows_progress_when_long(monkeypatch, capsys):
+    from geomlib import progress
+
+    V, F = icosphere(2)
+    monkeypatch.setattr(progress, "SECONDS", 0.0)
+    ImplicitSmoother(V, F).prepare([0.01, 0.1, 1.0], iterations=2)
+    assert "factorising the step values" in capsys.readouterr().err

@@ -1,13 +1,15 @@
 """Tests for geomlib.spectral: C e = -lam M e, E^T M E = I, reconstruction, cache."""
 
+import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from meshdata import COURSE
 
 import geomlib
-import geomlib.spectral as spectral
+import geomlib.cache as basis_cache
+import geomlib.eigen as eigen
 from geomlib import (
     MeshError,
     MeshWarning,
@@ -19,17 +21,16 @@ from geomlib import (
     spectral_reconstruction,
 )
 from geomlib.surfaces import ellipsoid, icosphere, sphere
-from meshdata import COURSE
 
 
 @pytest.fixture(autouse=True)
 def private_cache(tmp_path, monkeypatch):
     """Every test gets an empty cache folder of its own and an empty memory cache."""
     monkeypatch.setenv("GEOMLIB_CACHE_DIR", str(tmp_path / "cache"))
-    monkeypatch.setattr(spectral, "CACHE_DIR", None)
-    spectral._MEMORY.clear()
+    monkeypatch.setattr(basis_cache, "CACHE_DIR", None)
+    basis_cache.clear(memory=True)
     yield
-    spectral._MEMORY.clear()
+    basis_cache.forget()
 
 
 @pytest.fixture(scope="module")
@@ -94,24 +95,25 @@ def test_dense_and_sparse_agree(egg, method):
     np.testing.assert_allclose(np.diag(G), 1.0, atol=1e-7)
 
 
-@pytest.mark.parametrize("block", [1, 4, 7])
-def test_block_lanczos_on_a_diagonal_operator(block):
-    """Known spectrum with repeated values (multiplicity above the block size, too)."""
-    rng = np.random.default_rng(5)
-    n = 400
-    d = np.concatenate([np.full(9, 50.0), 10.0 / (1.0 + np.arange(n - 9))])  # like a shift-inverted spectrum
-    rng.shuffle(d)
-    theta, Y = spectral.block_lanczos(lambda X: d[:, None] * X, n, 30, block=block)
-    np.testing.assert_allclose(theta, np.sort(d)[::-1][:30], rtol=1e-10)
-    assert np.abs(Y.T @ Y - np.eye(30)).max() < 1e-10
-    assert np.abs(d[:, None] * Y - Y * theta).max() < 1e-9
+def test_smallest_eigenpairs_of_a_known_spectrum():
+    """A path graph's Laplacian: eigenvalues 2 - 2 cos(pi j / n), j = 0 .. n-1, every one simple."""
+    import scipy.sparse as sp
 
-
-def test_nested_dissection_is_a_permutation(egg_fine):
-    V, F = egg_fine
-    _, C = laplacian(V, F)
-    p = spectral.nested_dissection(C, V)
-    assert np.array_equal(np.sort(p), np.arange(len(V)))
+    n = 900
+    S = sp.diags([-np.ones(n - 1), np.r_[1.0, 2 * np.ones(n - 2), 1.0], -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    exact = 2 - 2 * np.cos(np.pi * np.arange(n) / n)
+    for method in ("dense", "sparse"):
+        lam, Y = eigen.smallest_eigenpairs(S, 12, 1e-6, method)
+        np.testing.assert_allclose(lam, exact[:12], atol=1e-12)
+        assert np.abs(Y.T @ Y - np.eye(12)).max() < 1e-10
+        assert np.abs(S @ Y - Y * lam).max() < 1e-10
+    top, y = eigen.largest_eigenpair(S)
+    assert abs(top - exact[-1]) <= 1e-8 * exact[-1] and top <= exact[-1] + 1e-12
+    assert np.abs(S @ y - top * y).max() < 1e-3
+    top = eigen.largest_eigenvalue(S)  # a cluster (the top gaps shrink like 1/n^2): within it, from below
+    assert exact[-2] < top <= exact[-1] + 1e-12
+    diagonal = sp.diags(np.linspace(1.0, 3.0, n)).tocsr()  # well separated: to 1e-8
+    assert abs(eigen.largest_eigenvalue(diagonal) - 3.0) <= 1e-8 * 3.0
 
 
 def test_unit_sphere_eigenvalues_are_l_l_plus_1():
@@ -299,8 +301,11 @@ def test_k_not_an_integer(egg, k):
 def test_isolated_vertex_is_named(egg):
     V, F = egg
     V2 = np.vstack([V, [[5.0, 5.0, 5.0]]])
-    with pytest.raises(MeshError, match=f"vertices {len(V)}"):
+    with pytest.raises(MeshError, match=rf"1 vertices are used by no face \({len(V)}\).*"
+                                         r"geomlib.repair.remove_unreferenced_vertices\(V, F\)"):
         eigenbasis(V2, F, 5, cache=False)
+    with pytest.raises(MeshError, match="remove_unreferenced_vertices"):
+        spectral_reconstruction(V2, F, 5)
 
 
 def test_bad_method(egg):
@@ -335,7 +340,7 @@ def test_cache_round_trip_and_slices(egg_fine, tmp_path):
     b2 = spectral_basis(V, F, 30)
     assert b2.source == "solved" and b2 is b
     # disk, as after a kernel restart; a basis with more pairs serves fewer
-    spectral._MEMORY.clear()
+    basis_cache.forget()
     b3 = spectral_basis(V, F, 12)
     assert b3.source == "disk"
     np.testing.assert_array_equal(b3.E, b.E[:, :12])
@@ -346,7 +351,7 @@ def test_cache_round_trip_and_slices(egg_fine, tmp_path):
 def test_cache_invalidated_by_mesh_and_operator(egg):
     V, F = egg
     spectral_basis(V, F, 10)
-    spectral._MEMORY.clear()
+    basis_cache.forget()
     assert spectral_basis(V, F, 10, area="mixed").source == "solved"
     assert spectral_basis(V, F, 10, weights="uniform").source == "solved"
     V2 = V.copy()
@@ -356,7 +361,7 @@ def test_cache_invalidated_by_mesh_and_operator(egg):
     assert spectral_basis(V, F2, 10).source == "solved"
     assert len(list(spectral_cache_dir().glob("*.npz"))) == 5
     # more pairs than stored: solved again, and the larger file replaces the smaller
-    spectral._MEMORY.clear()
+    basis_cache.forget()
     assert spectral_basis(V, F, 20).source == "solved"
     assert len(list(spectral_cache_dir().glob("*.npz"))) == 5
 
@@ -365,19 +370,19 @@ def test_cache_false_touches_nothing(egg):
     V, F = egg
     spectral_basis(V, F, 10, cache=False)
     assert not spectral_cache_dir().exists()
-    assert not spectral._MEMORY
+    assert not basis_cache._MEMORY
 
 
 def test_cache_folder_choice(egg, tmp_path, monkeypatch):
     V, F = egg
     spectral_basis(V, F, 6, cache_dir=tmp_path / "mine")
     assert len(list((tmp_path / "mine" / "spectral").glob("*.npz"))) == 1
-    monkeypatch.setattr(spectral, "CACHE_DIR", str(tmp_path / "attr"))
+    monkeypatch.setattr(basis_cache, "CACHE_DIR", str(tmp_path / "attr"))
     assert spectral_cache_dir() == tmp_path / "attr" / "spectral"
-    monkeypatch.setattr(spectral, "CACHE_DIR", None)
+    monkeypatch.setattr(basis_cache, "CACHE_DIR", None)
     monkeypatch.delenv("GEOMLIB_CACHE_DIR")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
-    if not spectral.sys.platform.startswith(("win", "darwin")):
+    if not sys.platform.startswith(("win", "darwin")):
         assert spectral_cache_dir() == tmp_path / "xdg" / "geomlib" / "spectral"
     assert clear_spectral_cache(tmp_path / "mine") == 1
 
@@ -387,10 +392,55 @@ def test_corrupt_cache_file_is_solved_again(egg):
     b = spectral_basis(V, F, 8)
     (path,) = spectral_cache_dir().glob("*.npz")
     path.write_bytes(b"not a numpy file")
-    spectral._MEMORY.clear()
-    b2 = spectral_basis(V, F, 8)
+    basis_cache.forget()
+    with pytest.warns(MeshWarning, match="damaged"):
+        b2 = spectral_basis(V, F, 8)
     assert b2.source == "solved"
     np.testing.assert_allclose(b2.lam, b.lam)
+    basis_cache.forget()
+    assert spectral_basis(V, F, 8).source == "disk"  # the damaged file was replaced
+
+
+def test_truncated_cache_file_is_solved_again(egg):
+    """As a full disk or a sync tool leaves it: the first half of a valid file."""
+    V, F = egg
+    b = spectral_basis(V, F, 8)
+    (path,) = spectral_cache_dir().glob("*.npz")
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    basis_cache.forget()
+    with pytest.warns(MeshWarning, match=f"{path.name} is damaged"):
+        lam, E = eigenbasis(V, F, 8)
+    np.testing.assert_allclose(lam, b.lam, rtol=1e-12, atol=1e-12)
+
+
+def test_file_where_the_cache_folder_should_be(egg, tmp_path):
+    V, F = egg
+    blocker = tmp_path / "blocked"
+    blocker.write_text("a file, not a folder")
+    with pytest.warns(MeshWarning, match="could not write the eigenbasis cache"):
+        lam, E = eigenbasis(V, F, 6, cache_dir=blocker)
+    assert blocker.read_text() == "a file, not a folder"
+    spectral_folder = tmp_path / "inner"
+    spectral_folder.mkdir()
+    (spectral_folder / "spectral").write_text("a file")
+    basis_cache.forget()
+    with pytest.warns(MeshWarning, match="is a file, not a folder"):
+        lam2, _ = eigenbasis(V, F, 6, cache_dir=spectral_folder)
+    np.testing.assert_array_equal(lam, lam2)
+
+
+def test_unwritable_cache_folder(egg, tmp_path, monkeypatch):
+    """A read-only folder (simulated: the tests may run as root, who may write anywhere)."""
+    V, F = egg
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(basis_cache.np, "savez", refuse)
+    with pytest.warns(MeshWarning, match="Permission denied"):
+        lam, E = eigenbasis(V, F, 6, cache_dir=tmp_path / "ro")
+    assert lam[0] == 0.0 and lam.shape == (6,)
+    assert not list((tmp_path / "ro").rglob("*.npz"))
 
 
 def test_public_names():
@@ -420,9 +470,23 @@ def test_course_armadillo():
 
 
 def test_blas_thread_setting_is_restored(egg):
-    handles = spectral._openblas_handles()
-    before = [getter() for _, getter in handles]
-    with spectral._blas_threads(1):
-        assert all(getter() == 1 for _, getter in handles)
+    from threadpoolctl import threadpool_info
+
+    before = [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+    with eigen.one_blas_thread():
+        assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")
     eigenbasis(*egg, 5, cache=False)
-    assert [getter() for _, getter in handles] == before
+    assert [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"] == before
+
+
+def test_long_solves_show_their_stages(egg_fine, monkeypatch, capsys):
+    import geomlib.progress as progress
+
+    V, F = egg_fine
+    monkeypatch.setattr(progress, "SECONDS", -1.0)  # every solve counts as long
+    eigenbasis(V, F, 20, cache=False, method="sparse")
+    err = capsys.readouterr().err
+    assert "20 eigenpairs (about" in err and "factorising" in err
+    monkeypatch.setattr(progress, "SECONDS", 1e9)  # none does
+    eigenbasis(V, F, 20, cache=False, method="sparse")
+    assert capsys.readouterr().err == ""
