@@ -3,6 +3,7 @@ at both ends of its documented range. No run may raise; the notes a run shows mu
 
 The runs are chosen to take different code paths (flat mesh, unused vertices and holes, two components,
 a model in millimetres, coarse and fine resolutions, a spheroid); several parameters move together per run.
+Notebook 01 and 00 share the cleaning step (geomlib.repair.prepare), so the scan with holes runs in 00 only.
 """
 
 import json
@@ -62,11 +63,12 @@ def test_00_flat_plane_never_folds_and_small_range():
 
 def test_00_y_up_millimetres(awkward):
     run = ran(NB00, MESH=awkward["y_up_millimetres"])
-    assert not run.notes, run.notes              # a sphere of radius 1000 mm folds at its focal distance, as stated
+    # the sphere folds near its radius, 1000 mm; the largest discrete |kappa| overstates the curvature
+    assert len(run.notes) == 1 and "noisy at single vertices" in run.notes[0], run.notes
 
 
 def test_01_low_ends_on_the_cad_part(awkward):
-    run = ran(NB01, MESH=awkward["cad_part"], RESOLUTION=8, SLIDER_RESOLUTION=8, JITTER_MAX=0.0,
+    run = ran(NB01, MESH=awkward["cad_part"], PLANE=Raw('geomlib.data_path("plane_irregular.obj")'), RESOLUTION=8, SLIDER_RESOLUTION=8, JITTER_MAX=0.0,
               SPHERE_SUBDIVISIONS=1, UV_RINGS=8, SEED=0)
     assert any("within 10 %" in n and "coarser grid" in n for n in run.notes), run.notes
     assert any("within 1 % of 1" in n and "coarse sphere" in n for n in run.notes), run.notes
@@ -78,11 +80,6 @@ def test_01_high_ends_on_two_components(awkward):
     assert not run.notes, run.notes
 
 
-def test_01_scan_with_holes(awkward):
-    run = ran(NB01, MESH=awkward["scan_with_holes"], PLANE=Raw('geomlib.data_path("plane_irregular.obj")'))
-    assert any("not used by any face" in n for n in run.notes), run.notes
-
-
 def test_02_spheroid_at_the_ends_of_the_ranges(awkward):
     run = ran(NB02, A_NUM=0.2, B_NUM=3.0, C_NUM=3.0, GENERIC_U=1.5, GENERIC_V=0.1, SUBDIVISIONS=1,
               MESH=awkward["y_up_millimetres"], SEED=0)
@@ -91,7 +88,7 @@ def test_02_spheroid_at_the_ends_of_the_ranges(awkward):
 
 @needs_course
 def test_course_meshes():
-    ran(NB00, MESH=str(COURSE / "curvatures" / "lilium_s.obj"))
-    run = ran(NB01, MESH=str(COURSE / "curvatures" / "plane.obj"), PLANE=str(COURSE / "curvatures" / "plane.obj"))
+    run = ran(NB00, MESH=str(COURSE / "curvatures" / "plane.obj"))
+    assert "never fold" in run.outputs_text() and not run.notes, run.notes
+    run = ran(NB01, MESH=str(COURSE / "curvatures" / "lilium_s.obj"), PLANE=str(COURSE / "curvatures" / "plane.obj"))
     assert not run.notes, run.notes
-    ran(NB02, MESH=str(COURSE / "curvatures" / "lilium_s.obj"), SUBDIVISIONS=6)
