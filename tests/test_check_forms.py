@@ -38,7 +38,7 @@ def as_matrices(a, b, c, u, v):
 
 
 def unnormalised(a, b, c, u, v):
-    p, p_u, p_v, m = parts(a, b, c, u, v)
+    p, _, _, m = parts(a, b, c, u, v)
     return forms(a, b, c, u, v)[:3] + (p.diff(u, 2).dot(m), p.diff(u, v).dot(m), p.diff(v, 2).dot(m))
 
 

@@ -11,7 +11,6 @@ import json
 import numpy as np
 import pytest
 import sympy as sp
-
 from awkward_meshes import make_all
 from meshdata import COURSE, ROOT, needs_course
 from notebook_runner import Raw, run_notebook
@@ -37,10 +36,10 @@ def test_saddle_height_stated_in_01_is_the_code():
     """The height function notebook 01 states (a sympy expression it displays) is surfaces.saddle_height."""
     nb = json.loads((ROOT / "notebooks" / NB01).read_text(encoding="utf-8"))
     source = next("".join(c["source"]) for c in nb["cells"] if "SADDLE_HEIGHT =" in "".join(c["source"]))
-    stated = "\n".join(line for line in source.splitlines()[:2])           # the symbols and the expression
-    scope = {"sp": sp}
-    exec(stated, scope)
-    h = sp.lambdify(sp.symbols("x y A B", real=True), scope["SADDLE_HEIGHT"], "numpy")
+    statement = next(line for line in source.splitlines() if line.startswith("SADDLE_HEIGHT ="))
+    x, y, A, B = sp.symbols("x y A B", real=True)
+    expression = sp.sympify(statement.split("=", 1)[1], locals={"x_": x, "y_": y, "A_": A, "B_": B, "sp": sp})
+    h = sp.lambdify((x, y, A, B), expression, "numpy")
     rng = np.random.default_rng(0)
     x, y = rng.uniform(-1, 1, (2, 500))
     for A, B in ((0.2, 0.1), (1.0, 0.0), (-0.3, 0.7)):

@@ -143,8 +143,8 @@ def normal_curvature(fn):
     if _same(got, right):
         return ["(a, 0, 0) of three ellipsoids, six directions each"]
     diagnoses = [
-        (-right, "the sign is flipped", "at (a, 0, 0) the ellipsoid bends away from its outward normal: "
-                                        "kappa_n > 0, as on a sphere"),
+        (-right, "the sign is flipped",
+         "at (a, 0, 0) the ellipsoid bends away from its outward normal: kappa_n > 0, as on a sphere"),
         (a * sin2 / b**2 + a * cos2 / c**2,
          "kappa_n(0) came out a / c^2: b and c are exchanged, or phi is measured from p_v instead of p_u",
          "phi = 0 is the direction of p_u = (0, b, 0), of length b, so kappa_n(0) = e / E = a / b^2"),

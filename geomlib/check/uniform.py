@@ -7,7 +7,7 @@ from ..curvature import gaussian_curvature as geomlib_gaussian_curvature
 from ..laplace import barycentric_areas, laplacian, mixed_areas
 from .result import Mistake, call, close, exercise, matrix_pair, vector
 
-__all__ = ["uniform_laplacian", "gaussian_curvature"]
+__all__ = ["gaussian_curvature", "uniform_laplacian"]
 
 # a tetrahedron (valence 3 everywhere) and a 3 x 3 vertex grid (valences 2..6)
 _TET_V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
