@@ -65,6 +65,8 @@ import sympy as sp
 __all__ = [
     "ParametricSurface",
     "ellipsoid",
+    "ellipsoid_forms",
+    "ellipsoid_normal_curvature",
     "sphere",
     "torus",
     "helicoid",
@@ -694,6 +696,28 @@ def ellipsoid(a, b, c):
     singular at v = 0 and v = pi).
     """
     return _member(_ellipsoid_family(), (a, b, c))
+
+
+def ellipsoid_forms(a, b, c, u, v):
+    """(I, II) of ``ellipsoid(a, b, c)`` at (u, v): two 2x2 sympy matrices.
+
+    I = [[E, F], [F, G]] in length^2, II = [[e, f], [f, g]] in length with the
+    inward normal N = p_u x p_v / |p_u x p_v| (module docstring). ``a, b, c, u, v``
+    are numbers or sympy symbols: the reference of the exercise of notebook 02.
+    """
+    ell = ellipsoid(a, b, c)
+    at = {ell.u: u, ell.v: v}
+    return ell.first_fundamental_form().subs(at), ell.second_fundamental_form().subs(at)
+
+
+def ellipsoid_normal_curvature(a, b, c, phi, u=0.0, v=math.pi / 2):
+    """kappa_n(phi) of ``ellipsoid(a, b, c)`` at (u, v), by default the point (a, 0, 0), in 1/length.
+
+    ``phi`` in radians from p_u (module docstring); numbers or numpy arrays in,
+    float64 out (a compiled function of the family, so many calls are cheap).
+    At (a, 0, 0) it is ``a cos^2 phi / b^2 + a sin^2 phi / c^2``.
+    """
+    return ellipsoid(a, b, c).lambdify("normal_curvature")(u, v, phi)
 
 
 @functools.lru_cache(maxsize=None)

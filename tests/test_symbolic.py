@@ -436,3 +436,18 @@ def test_results_are_cached_and_families_shared():
     assert E1.first_fundamental_form() is E1.first_fundamental_form()
     assert E1.lambdify("mean_curvature")  # compiled once per family
     assert "mean_curvature" in E1._family._lambdified
+
+
+def test_ellipsoid_forms_at_a_point_and_kappa_n_at_the_axis_end():
+    a, b, c = sp.symbols("a b c", positive=True)
+    I, II = symbolic.ellipsoid_forms(a, b, c, 0, sp.pi / 2)
+    assert sp.simplify(I - sp.diag(b**2, c**2)) == sp.zeros(2, 2)
+    assert sp.simplify(II - sp.diag(a, a)) == sp.zeros(2, 2)
+    phi = np.linspace(0, 2 * np.pi, 13)
+    expected = 2.0 * np.cos(phi) ** 2 / 1.5**2 + 2.0 * np.sin(phi) ** 2 / 0.7**2      # a cos^2/b^2 + a sin^2/c^2
+    assert np.allclose(symbolic.ellipsoid_normal_curvature(2.0, 1.5, 0.7, phi), expected, rtol=1e-12)
+    # at a generic point the numbers agree with the library's form of the same ellipsoid
+    I_num, II_num = symbolic.ellipsoid_forms(2.0, 1.5, 0.7, 0.7, 1.0)
+    ell = symbolic.ellipsoid(2.0, 1.5, 0.7)
+    assert np.allclose(np.array(I_num, dtype=float), ell.lambdify("first_fundamental_form")(0.7, 1.0), rtol=1e-12)
+    assert np.allclose(np.array(II_num, dtype=float), ell.lambdify("second_fundamental_form")(0.7, 1.0), rtol=1e-12)
