@@ -2,9 +2,12 @@
 
 The case: a jittered ellipsoid with 42 vertices (vertex areas differing by a
 factor of about 3, so the M inner product matters) and all its eigenpairs
-``C e = -lam M e``, ``E^T M E = I``, solved densely here; the learner's
-``fn(V, M, E, k)`` is run at a small k and at k = n, where the right answer is
-V itself. The typical mistakes are rebuilt and named when met.
+``C e = -lam M e``, ``E^T M E = I``, solved densely here. The learner's
+``fn(V, F, k)`` (the signature of ``geomlib.spectral_reconstruction``, built
+from ``geomlib.laplacian`` and ``geomlib.eigenbasis``) is run at a small k and
+at k = n, where the right answer is V itself. The projection onto the first k
+eigenvectors does not depend on their signs, so the typical mistakes can be
+rebuilt from this E and named when met.
 """
 
 import numpy as np
@@ -23,7 +26,7 @@ def _case():
     e = ellipsoid(1.0, 0.7, 0.5, subdivisions=1, jitter=0.3, seed=1)
     M, C = laplacian(e.V, e.F)
     lam, E = scipy.linalg.eigh(-C.toarray(), M.toarray())
-    return e.V, M, E
+    return e.V, e.F, M.toarray(), C.toarray(), E
 
 
 def _positions(out, n, k):
@@ -46,24 +49,25 @@ def _project(E, W, V):
 
 @exercise("spectral_reconstruction", reread=_REREAD)
 def spectral_reconstruction(fn):
-    """Check ``fn(V, M, E, k) -> V_k``: V_k = E_k E_k^T M V with E_k the first k columns of E."""
-    V, M, E = _case()
+    """Check ``fn(V, F, k) -> V_k``: V_k = E_k E_k^T M V with E_k the first k eigenvectors."""
+    V, F, M, C, E = _case()
     n, m = len(V), M.diagonal()
     scale = np.abs(V).max()
     checked = []
     for k in (5, n):
-        X = _positions(call(fn, V.copy(), M.copy(), E.copy(), k), n, k)
+        X = _positions(call(fn, V.copy(), F.copy(), k), n, k)
         Ek = E[:, :k]
         ref = _project(Ek, lambda X: m[:, None] * X, V)
         wrong = {
             "plain": _project(Ek, lambda X: X, V),
             "inverse": _project(Ek, lambda X: X / m[:, None], V),
             "left": m[:, None] * _project(Ek, lambda X: X, V),
+            "C": _project(Ek, lambda X: C @ X, V),
+            "Delta": _project(Ek, lambda X: (C @ X) / m[:, None], V),
             "no mean": _project(E[:, 1:k], lambda X: m[:, None] * X, V),
             "one less": _project(E[:, :k - 1], lambda X: m[:, None] * X, V),
             "one more": _project(E[:, :k + 1], lambda X: m[:, None] * X, V),
             "shifted": _project(E[:, 1:k + 1], lambda X: m[:, None] * X, V),
-            "last": _project(E[:, -k:], lambda X: m[:, None] * X, V),
         }
 
         def is_(name):
@@ -79,15 +83,15 @@ def spectral_reconstruction(fn):
         if is_("left"):
             raise Mistake("M multiplies the result (M E_k E_k^T V) instead of V inside the inner product",
                           "V_k = E_k (E_k^T (M V))")
+        if is_("C") or is_("Delta"):
+            raise Mistake("C (or M^-1 C) is used where M belongs in the inner product",
+                          "the eigenvectors are orthonormal in <f, g>_M = f^T M g: the coefficients are E_k^T M V")
         if is_("no mean"):
             raise Mistake("the constant eigenvector e_0 (the mean, lam = 0) is left out, so the shape is "
                           "centred at the origin", "use the columns 0 .. k-1 of E, e_0 included: E[:, :k]")
         if is_("one less") or is_("one more") or is_("shifted"):
             raise Mistake("k is off by one: the slice of E does not hold exactly the first k columns",
                           "E[:, :k] holds e_0 .. e_{k-1}")
-        if is_("last"):
-            raise Mistake("the last k eigenvectors are used, not the first k",
-                          "eigenvalues are ascending: the first columns of E are the smooth ones")
         if not close(X, ref, rtol=1e-6, atol=1e-9 * scale):
             raise Mistake(f"V_k differs from the M-orthogonal projection at k = {k} "
                           f"(largest difference {np.abs(X - ref).max():.3g}, coordinates up to {scale:.3g})",
