@@ -6,10 +6,8 @@ the cause. Runs are chosen to take different code paths at small sizes (the budg
 about two minutes on a quiet machine); the convergence study of 03 runs on two or three coarse levels.
 """
 
-import pytest
-
-from meshdata import COURSE, needs_course
 from awkward_meshes import cad_part, scan_with_holes, two_components, y_up_millimetres
+from meshdata import COURSE, needs_course
 from notebook_runner import run_notebook
 
 NB03, NB04 = "03_cotangent_laplace.ipynb", "04_spectral_reconstruction.ipynb"

@@ -25,7 +25,7 @@ _REREAD = "section 4 · Reconstruction from the first k eigenvectors"
 def _case():
     e = ellipsoid(1.0, 0.7, 0.5, subdivisions=1, jitter=0.3, seed=1)
     M, C = laplacian(e.V, e.F)
-    lam, E = scipy.linalg.eigh(-C.toarray(), M.toarray())
+    _, E = scipy.linalg.eigh(-C.toarray(), M.toarray())
     return e.V, e.F, M.toarray(), C.toarray(), E
 
 
@@ -70,7 +70,7 @@ def spectral_reconstruction(fn):
             "shifted": _project(E[:, 1:k + 1], lambda X: m[:, None] * X, V),
         }
 
-        def is_(name):
+        def is_(name, X=X, wrong=wrong, ref=ref):
             return close(X, wrong[name], rtol=1e-6, atol=1e-9 * scale) and not close(wrong[name], ref)
 
         if is_("plain"):
