@@ -10,7 +10,7 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from geomlib import check
+from geomlib import check, explicit_step_limit as reference_limit_of_mesh, laplacian
 from geomlib.check import CheckFailed
 from geomlib.smoothing import explicit_step, implicit_step
 
@@ -44,12 +44,18 @@ STEP_MISTAKES = {
     "something else": (lambda P, M, C, tau: P + 0.5 * tau * (C @ P) / areas(M), "differ from P + tau M^-1 C P"),
 }
 
+def on_matrices(wrong):
+    """A learner's fn(V, F) that builds (M, C) and then makes the mistake ``wrong(M, C)``."""
+    return lambda V, F: wrong(*laplacian(V, F))
+
+
 LIMIT_MISTAKES = {
     "1/lam_max": (lambda M, C: reference_limit(M, C) / 2, "1 / lam_max, half the true one"),
     "eigenvalues of C": (lambda M, C: 2 / np.linalg.eigvalsh(-C.toarray())[-1], "from C instead of M^-1 C"),
     "smallest non-zero": (lambda M, C: 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[1],
                           "smallest non-zero eigenvalue"),
-    "smallest, zero": (lambda M, C: np.inf, "smallest eigenvalue (0, the constant mode)"),
+    "smallest, zero": (lambda M, C: 2 / abs(scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[0]),
+                       "smallest eigenvalue (0, the constant mode)"),
     "sign": (lambda M, C: -reference_limit(M, C), "negative limit"),
     "lam_max itself": (lambda M, C: 2 / reference_limit(M, C), "returns lam_max"),
     "a vector": (lambda M, C: np.full(3, reference_limit(M, C)), "not one number"),
@@ -66,7 +72,8 @@ IMPLICIT_MISTAKES = {
 
 
 def test_references_pass_quickly():
-    for name, fn in (("explicit_step", explicit_step), ("explicit_step_limit", reference_limit),
+    for name, fn in (("explicit_step", explicit_step), ("explicit_step_limit", reference_limit_of_mesh),
+                     ("explicit_step_limit", on_matrices(reference_limit)),
                      ("implicit_step", implicit_step)):
         start = time.perf_counter()
         result = getattr(check, name)(fn)
@@ -92,8 +99,8 @@ def test_explicit_step_mistakes(name):
 
 @pytest.mark.parametrize("name", LIMIT_MISTAKES)
 def test_explicit_step_limit_mistakes(name):
-    fn, phrase = LIMIT_MISTAKES[name]
-    result = check.explicit_step_limit(fn)
+    wrong, phrase = LIMIT_MISTAKES[name]
+    result = check.explicit_step_limit(on_matrices(wrong))
     assert not result.passed
     assert phrase in result.message, result.message
     assert "Reread section 3 · Why the step has a limit" in result.message

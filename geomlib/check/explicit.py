@@ -88,14 +88,15 @@ def _lam(A, M):
 
 @exercise("explicit_step_limit", reread=_REREAD_LIMIT)
 def explicit_step_limit(fn):
-    """Check ``fn(M, C) -> tau_max`` = 2 / lam_max, lam_max the largest eigenvalue of -M^-1 C."""
+    """Check ``fn(V, F) -> tau_max`` = 2 / lam_max, lam_max the largest eigenvalue of -M^-1 C
+    for the cotangent operator ``(M, C) = laplacian(V, F)`` (closed meshes: no boundary rule)."""
     checked = []
     for label, V, F in step_cases():
         M, C = laplacian(V, F)
         lam = _lam(-C, M)
         lam_max, lam_1 = lam[-1], lam[lam > 1e-9 * lam[-1]][0]
         c_max = np.linalg.eigvalsh(-C.toarray())[-1]
-        out = call(fn, M.copy(), C.copy())
+        out = call(fn, V.copy(), F.copy())
         try:
             tau = float(np.asarray(out).reshape(()))
         except (TypeError, ValueError):
