@@ -436,42 +436,41 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
     y1 = np.floor(Y.max(axis=1) - 0.5).astype(np.int64) + 1
     area = (X[:, 1] - X[:, 0]) * (Y[:, 2] - Y[:, 0]) - (X[:, 2] - X[:, 0]) * (Y[:, 1] - Y[:, 0])
     visible = (x1 >= 0) & (y1 >= 0) & (x0 < width) & (y0 < height) & (np.abs(area) > 1e-12)
-    span = np.maximum(x1 - x0, y1 - y0) + 1
+    # pixel boxes clipped to the image, and grouped by their width and height rounded up to powers of
+    # two: a long sliver (a spike of an unstable run) is tested on its own box, not on a square around it
+    x0, y0 = np.maximum(x0, 0), np.maximum(y0, 0)
+    x1, y1 = np.minimum(x1, width - 1), np.minimum(y1, height - 1)
+    bw = 2 ** np.ceil(np.log2(np.maximum(x1 - x0 + 1, 1))).astype(np.int64)
+    bh = 2 ** np.ceil(np.log2(np.maximum(y1 - y0 + 1, 1))).astype(np.int64)
     pix_all, key_all, col_all = [], [], []
-    size = 1
-    while True:
-        group = visible & (span <= size) & (span > size // 2 if size > 1 else True)
-        ids = np.flatnonzero(group)
-        if ids.size:
-            off = np.arange(size)
-            ox, oy = np.meshgrid(off, off)
-            ox, oy = ox.ravel(), oy.ravel()
-            chunk = max(1, 2_000_000 // (size * size))
-            for start in range(0, ids.size, chunk):
-                fi = ids[start:start + chunk]
-                px = x0[fi, None] + ox[None, :]
-                py = y0[fi, None] + oy[None, :]
-                cx, cy = px + 0.5, py + 0.5
-                Xf, Yf = X[fi], Y[fi]
-                a = area[fi, None]
-                b0 = ((Xf[:, 1, None] - cx) * (Yf[:, 2, None] - cy) - (Xf[:, 2, None] - cx) * (Yf[:, 1, None] - cy)) / a
-                b1 = ((Xf[:, 2, None] - cx) * (Yf[:, 0, None] - cy) - (Xf[:, 0, None] - cx) * (Yf[:, 2, None] - cy)) / a
-                b2 = 1.0 - b0 - b1
-                inside = (b0 >= 0) & (b1 >= 0) & (b2 >= 0) & (px >= 0) & (py >= 0) & (px < width) & (py < height)
-                if not inside.any():
-                    continue
-                r, c = np.nonzero(inside)
-                ff = F[fi[r]]
-                bb0, bb1, bb2 = b0[r, c], b1[r, c], b2[r, c]
-                key = bb0 * inv[ff[:, 0]] + bb1 * inv[ff[:, 1]] + bb2 * inv[ff[:, 2]]
-                col = (bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]]
-                       + bb2[:, None] * vc[ff[:, 2]])
-                pix_all.append(py[r, c] * width + px[r, c])
-                key_all.append(key)
-                col_all.append(col)
-        if size >= span[visible].max(initial=1):
-            break
-        size *= 2
+    vis = np.flatnonzero(visible)
+    for sw, sh in np.unique(np.stack([bw[vis], bh[vis]], axis=1), axis=0):
+        ids = vis[(bw[vis] == sw) & (bh[vis] == sh)]
+        ox, oy = np.meshgrid(np.arange(sw), np.arange(sh))
+        ox, oy = ox.ravel(), oy.ravel()
+        chunk = max(1, 2_000_000 // int(sw * sh))
+        for start in range(0, ids.size, chunk):
+            fi = ids[start:start + chunk]
+            px = x0[fi, None] + ox[None, :]
+            py = y0[fi, None] + oy[None, :]
+            cx, cy = px + 0.5, py + 0.5
+            Xf, Yf = X[fi], Y[fi]
+            a = area[fi, None]
+            b0 = ((Xf[:, 1, None] - cx) * (Yf[:, 2, None] - cy) - (Xf[:, 2, None] - cx) * (Yf[:, 1, None] - cy)) / a
+            b1 = ((Xf[:, 2, None] - cx) * (Yf[:, 0, None] - cy) - (Xf[:, 0, None] - cx) * (Yf[:, 2, None] - cy)) / a
+            b2 = 1.0 - b0 - b1
+            inside = (b0 >= 0) & (b1 >= 0) & (b2 >= 0) & (px < width) & (py < height)
+            if not inside.any():
+                continue
+            r, c = np.nonzero(inside)
+            ff = F[fi[r]]
+            bb0, bb1, bb2 = b0[r, c], b1[r, c], b2[r, c]
+            key = bb0 * inv[ff[:, 0]] + bb1 * inv[ff[:, 1]] + bb2 * inv[ff[:, 2]]
+            col = (bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]]
+                   + bb2[:, None] * vc[ff[:, 2]])
+            pix_all.append(py[r, c] * width + px[r, c])
+            key_all.append(key)
+            col_all.append(col)
     image = np.empty((height * width, 3), dtype=np.float64)
     image[:] = background
     if pix_all:
