@@ -63,6 +63,21 @@ outward-oriented mesh back faces are skipped (they cannot be seen from
 outside; the software WebGL of headless browsers draws large meshes about
 twice as fast); open or inconsistently oriented meshes show both sides.
 
+Pictures that must not mislead
+------------------------------
+* A field that is zero up to rounding (every finite ``|value| <= zero_tol``,
+  default :data:`ZERO_TOL`) is drawn in :data:`ZERO_COLOR` (white) and its colour
+  bar says "0 everywhere"; it is never stretched over the whole colour map.
+* ``MeshView(P, F, frame=V)`` frames the camera on ``V`` (the input before
+  smoothing): a result that shrank or collapsed is drawn at the input's scale,
+  so the collapse is seen instead of being reframed away. ``update`` never
+  moves the camera either.
+* ``side_by_side`` links the cameras of views of different sizes without
+  shrinking the smaller ones to specks: views of one mesh (the same faces)
+  keep their common scale, and a group of views of a mesh smaller than
+  :data:`SPECK_RATIO` times the largest is drawn enlarged to its size, with
+  "drawn N x larger" under its title.
+
 Without a front-end
 -------------------
 ``display(view)`` gives the widget together with a still picture (image/png,
@@ -86,6 +101,14 @@ __all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fa
 
 #: colour of vertices whose value is NaN (RGB in [0, 1])
 NAN_COLOR = (0.62, 0.62, 0.62)
+#: colour of a field that is zero up to rounding (white: nothing to see)
+ZERO_COLOR = (1.0, 1.0, 1.0)
+#: default ``zero_tol``: a field whose finite values all satisfy |v| <= ZERO_TOL
+#: (in its own units) is zero up to rounding and drawn in ZERO_COLOR
+ZERO_TOL = 1e-10
+#: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
+#: of the largest one is drawn enlarged to the largest one's size
+SPECK_RATIO = 0.25
 #: colour of a surface without values
 PLAIN_COLOR = (0.74, 0.78, 0.86)
 #: the axis drawn upwards -> (up vector, viewing direction from the bounding-box
@@ -368,8 +391,11 @@ def _look_at_quaternion(direction, up=UP):
 
 
 def render_still(V, F, colors, normals=None, width=420, height=340, direction=VIEW_DIRECTION,
-                 up=UP, distance=None, fov=FOV, background=(1.0, 1.0, 1.0)):
+                 up=UP, distance=None, fov=FOV, background=(1.0, 1.0, 1.0), centre=None):
     """Draw the mesh as the viewer's camera first sees it, into an RGB image.
+
+    The camera looks at ``centre`` (default: the centre of V's bounding box)
+    from ``distance`` (default: framing V's bounding box).
 
     A z-buffer rasteriser in numpy: vertices are projected with the camera of
     the 3D view, shaded by the same head light (|n . e|, both sides lit), and
@@ -382,7 +408,8 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
     (height, width, 3) uint8
     """
     V = np.asarray(V, dtype=np.float64)
-    centre, radius = _frame(V)
+    own_centre, radius = _frame(V)
+    centre = own_centre if centre is None else np.asarray(centre, dtype=np.float64)
     if distance is None:
         distance = _camera_distance(radius, width, height, fov)
     right, up, w = _basis(direction, up)
@@ -409,42 +436,41 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
     y1 = np.floor(Y.max(axis=1) - 0.5).astype(np.int64) + 1
     area = (X[:, 1] - X[:, 0]) * (Y[:, 2] - Y[:, 0]) - (X[:, 2] - X[:, 0]) * (Y[:, 1] - Y[:, 0])
     visible = (x1 >= 0) & (y1 >= 0) & (x0 < width) & (y0 < height) & (np.abs(area) > 1e-12)
-    span = np.maximum(x1 - x0, y1 - y0) + 1
+    # pixel boxes clipped to the image, and grouped by their width and height rounded up to powers of
+    # two: a long sliver (a spike of an unstable run) is tested on its own box, not on a square around it
+    x0, y0 = np.maximum(x0, 0), np.maximum(y0, 0)
+    x1, y1 = np.minimum(x1, width - 1), np.minimum(y1, height - 1)
+    bw = 2 ** np.ceil(np.log2(np.maximum(x1 - x0 + 1, 1))).astype(np.int64)
+    bh = 2 ** np.ceil(np.log2(np.maximum(y1 - y0 + 1, 1))).astype(np.int64)
     pix_all, key_all, col_all = [], [], []
-    size = 1
-    while True:
-        group = visible & (span <= size) & (span > size // 2 if size > 1 else True)
-        ids = np.flatnonzero(group)
-        if ids.size:
-            off = np.arange(size)
-            ox, oy = np.meshgrid(off, off)
-            ox, oy = ox.ravel(), oy.ravel()
-            chunk = max(1, 2_000_000 // (size * size))
-            for start in range(0, ids.size, chunk):
-                fi = ids[start:start + chunk]
-                px = x0[fi, None] + ox[None, :]
-                py = y0[fi, None] + oy[None, :]
-                cx, cy = px + 0.5, py + 0.5
-                Xf, Yf = X[fi], Y[fi]
-                a = area[fi, None]
-                b0 = ((Xf[:, 1, None] - cx) * (Yf[:, 2, None] - cy) - (Xf[:, 2, None] - cx) * (Yf[:, 1, None] - cy)) / a
-                b1 = ((Xf[:, 2, None] - cx) * (Yf[:, 0, None] - cy) - (Xf[:, 0, None] - cx) * (Yf[:, 2, None] - cy)) / a
-                b2 = 1.0 - b0 - b1
-                inside = (b0 >= 0) & (b1 >= 0) & (b2 >= 0) & (px >= 0) & (py >= 0) & (px < width) & (py < height)
-                if not inside.any():
-                    continue
-                r, c = np.nonzero(inside)
-                ff = F[fi[r]]
-                bb0, bb1, bb2 = b0[r, c], b1[r, c], b2[r, c]
-                key = bb0 * inv[ff[:, 0]] + bb1 * inv[ff[:, 1]] + bb2 * inv[ff[:, 2]]
-                col = (bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]]
-                       + bb2[:, None] * vc[ff[:, 2]])
-                pix_all.append(py[r, c] * width + px[r, c])
-                key_all.append(key)
-                col_all.append(col)
-        if size >= span[visible].max(initial=1):
-            break
-        size *= 2
+    vis = np.flatnonzero(visible)
+    for sw, sh in np.unique(np.stack([bw[vis], bh[vis]], axis=1), axis=0):
+        ids = vis[(bw[vis] == sw) & (bh[vis] == sh)]
+        ox, oy = np.meshgrid(np.arange(sw), np.arange(sh))
+        ox, oy = ox.ravel(), oy.ravel()
+        chunk = max(1, 2_000_000 // int(sw * sh))
+        for start in range(0, ids.size, chunk):
+            fi = ids[start:start + chunk]
+            px = x0[fi, None] + ox[None, :]
+            py = y0[fi, None] + oy[None, :]
+            cx, cy = px + 0.5, py + 0.5
+            Xf, Yf = X[fi], Y[fi]
+            a = area[fi, None]
+            b0 = ((Xf[:, 1, None] - cx) * (Yf[:, 2, None] - cy) - (Xf[:, 2, None] - cx) * (Yf[:, 1, None] - cy)) / a
+            b1 = ((Xf[:, 2, None] - cx) * (Yf[:, 0, None] - cy) - (Xf[:, 0, None] - cx) * (Yf[:, 2, None] - cy)) / a
+            b2 = 1.0 - b0 - b1
+            inside = (b0 >= 0) & (b1 >= 0) & (b2 >= 0) & (px < width) & (py < height)
+            if not inside.any():
+                continue
+            r, c = np.nonzero(inside)
+            ff = F[fi[r]]
+            bb0, bb1, bb2 = b0[r, c], b1[r, c], b2[r, c]
+            key = bb0 * inv[ff[:, 0]] + bb1 * inv[ff[:, 1]] + bb2 * inv[ff[:, 2]]
+            col = (bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]]
+                   + bb2[:, None] * vc[ff[:, 2]])
+            pix_all.append(py[r, c] * width + px[r, c])
+            key_all.append(key)
+            col_all.append(col)
     image = np.empty((height * width, 3), dtype=np.float64)
     image[:] = background
     if pix_all:
@@ -484,6 +510,13 @@ def _colorbar_html(lut, vmin, vmax, label, n_nan, width):
         f"<div style='flex:1;height:12px;border:1px solid #888;background:linear-gradient(to right, {stops})'></div>"
         f"<span class='geomlib-vmax'>{_fmt(vmax)}</span></div>{label_html}</div>"
     )
+
+
+def _zero_html(text, label, width):
+    label_html = f"<div style='text-align:center'>{html.escape(label)}</div>" if label else ""
+    return (f"<div class='geomlib-colorbar geomlib-zero' style='width:{width}px;font:12px sans-serif;"
+            f"color:#222'><div style='border:1px solid #888;background:#fff;text-align:center'>"
+            f"{html.escape(text)}</div>{label_html}</div>")
 
 
 def _still_with_colorbar(image, lut, vmin, vmax, label, title):
@@ -562,6 +595,14 @@ class MeshView:
         fields such as the course's plane; scanned models (bunny, armadillo)
         usually want "y". The camera looks from the front, a little from the
         right and above; orbit from there.
+    frame : (k, 3) float64 or None
+        Positions whose bounding box frames the camera, e.g. the input mesh when
+        V is its smoothed result: a mesh that shrank or collapsed is then drawn
+        at the input's scale. Default: V itself.
+    zero_tol : float >= 0
+        A field whose finite values all lie within ``zero_tol`` of zero (in the
+        values' units) is zero up to rounding: drawn in ``ZERO_COLOR`` (white),
+        its colour bar saying so. 0 switches this off.
 
     Attributes
     ----------
@@ -577,7 +618,8 @@ class MeshView:
     """
 
     def __init__(self, V, F, values=None, cmap=None, symmetric=False, vmin=None, vmax=None,
-                 wireframe=False, width=420, height=340, title=None, label=None, up="z"):
+                 wireframe=False, width=420, height=340, title=None, label=None, up="z",
+                 frame=None, zero_tol=ZERO_TOL):
         import ipywidgets as widgets
         import pythreejs as three
 
@@ -599,7 +641,9 @@ class MeshView:
             raise MeshError(f"up must be one of 'x', 'y', 'z' (the axis drawn upwards); got {up!r}")
         self.up = up
         self._up, self._direction = VIEWS[up]
-        self._centre, self._radius = _frame(V)
+        self.zero_tol = float(zero_tol)
+        self._centre, self._radius = _frame(V if frame is None else _check_vertices(frame, name="frame"))
+        self._scale = 1.0           # drawn this many times larger (side_by_side enlarges specks)
         self._distance = _camera_distance(self._radius, self.width, self.height)
 
         # one interleaved float32 buffer: position (0:3), normal (3:6), colour (6:9)
@@ -645,9 +689,8 @@ class MeshView:
                                        width=self.width, height=self.height, antialias=antialias)
         self.renderer.add_class("geomlib-canvas")
 
-        self._title = widgets.HTML(
-            f"<b>{html.escape(title)}</b>" if title else "",
-            layout=widgets.Layout(display=None if title else "none"))
+        self._title = widgets.HTML(self._title_text(),
+                                   layout=widgets.Layout(display=None if title else "none"))
         self._colorbar = widgets.HTML(self._colorbar_text(),
                                       layout=widgets.Layout(display=None if self._values is not None else "none"))
         self.widget = widgets.VBox([self._title, self.renderer, self._colorbar],
@@ -691,9 +734,28 @@ class MeshView:
         """(n, 3) float32 unit vertex normals as sent to the browser."""
         return self._buffer.array[:, 3:6].copy()
 
+    @property
+    def is_zero(self):
+        """True when the values are zero up to rounding (every finite |value| <= zero_tol)."""
+        if self._values is None:
+            return False
+        finite = self._values[np.isfinite(self._values)]
+        return bool(finite.size) and float(np.abs(finite).max()) <= self.zero_tol
+
+    def _title_text(self):
+        text = f"<b>{html.escape(self.title)}</b>" if self.title else ""
+        if self._scale != 1.0:
+            text += f" <i>(drawn {self._scale:.3g} x larger)</i>"
+        return text
+
     def _colors(self):
         if self._values is None:
             return np.broadcast_to(np.asarray(PLAIN_COLOR, dtype=np.float32), (self._n, 3))
+        if self.is_zero:
+            colors = np.empty((self._n, 3), dtype=np.float32)
+            colors[:] = ZERO_COLOR
+            colors[np.isnan(self._values)] = NAN_COLOR
+            return colors
         lo, hi = self.range
         return colorize(self._values, vmin=lo, vmax=hi, lut=self._lut)
 
@@ -713,12 +775,27 @@ class MeshView:
             buf[:, 6:9] = old[:, 6:9]
         return buf
 
+    def _set_scale(self, scale):
+        """Draw the mesh ``scale`` times larger (about its frame's centre), saying so in the title."""
+        self._scale = float(scale)
+        for obj in (self.mesh, self.wireframe):
+            if obj is not None:
+                obj.scale = (self._scale,) * 3
+        self._title.value = self._title_text()
+        self._title.layout.display = None if self._title.value else "none"
+
     def _colorbar_text(self):
         if self._values is None:
             return ""
-        lo, hi = self.range
         n_nan = int(np.isnan(self._values).sum())
+        if self.is_zero:
+            return _zero_html(self._zero_text(), self.label or "", self.width)
+        lo, hi = self.range
         return _colorbar_html(self._lut, lo, hi, self.label or "", n_nan, self.width)
+
+    def _zero_text(self):
+        largest = float(np.nanmax(np.abs(self._values)))
+        return f"0 everywhere, up to rounding (largest |value| {_fmt(largest)} <= {_fmt(self.zero_tol)})"
 
     # -- updates ---------------------------------------------------------------
 
@@ -765,17 +842,26 @@ class MeshView:
         buf = self._buffer.array
         image = render_still(self._V, self._F, buf[:, 6:9], buf[:, 3:6].astype(np.float64),
                              self.width, self.height, direction=self._direction, up=self._up,
-                             distance=distance or self._distance)
+                             distance=(distance or self._distance) / self._scale, centre=self._centre)
         lo, hi = self.range
-        lut = self._lut if self._values is not None else None
-        return _still_with_colorbar(image, lut, lo, hi, self.label or "", self.title)
+        lut = self._lut if self._values is not None and not self.is_zero else None
+        title = self.title
+        if title and self._scale != 1.0:
+            title = f"{title} (drawn {self._scale:.3g} x larger)"
+        if self.is_zero:
+            title = f"{title or ''}  [{self.label or 'values'}: 0 everywhere]".strip()
+        return _still_with_colorbar(image, lut, lo, hi, self.label or "", title)
 
     def summary(self):
         """One line of text describing the view (the text/plain display)."""
         text = f"MeshView: {self._n} vertices, {self._F.shape[0]} faces"
         if self.title:
             text = f"{text} ({self.title})"
-        if self._values is not None:
+        if self._scale != 1.0:
+            text += f", drawn {self._scale:.3g} x larger"
+        if self._values is not None and self.is_zero:
+            text += f"; {self.label or 'values'}: {self._zero_text()}, drawn white"
+        elif self._values is not None:
             lo, hi = self.range
             name = self.label or "values"
             text += f"; {name} coloured by {self.cmap} over [{_fmt(lo)}, {_fmt(hi)}]"
@@ -828,8 +914,15 @@ def side_by_side(*views, link_cameras=True):
 
     Linked views share the first view's camera and orbit controls, so orbiting,
     zooming or panning in any of them turns all of them together (every mesh is
-    centred on its bounding box; the camera is framed on the largest). Views
-    are resized to the first view's canvas size (one camera, one aspect ratio).
+    centred on its bounding box, or its ``frame``; the camera is framed on the
+    largest). Views are resized to the first view's canvas size (one camera,
+    one aspect ratio).
+
+    Sizes: views of the same mesh (equal faces ``F``) keep their common scale,
+    so a result that shrank is seen shrunk next to its input. A group of views
+    of another, much smaller mesh (bounding box below ``SPECK_RATIO`` of the
+    largest) would be a speck under the shared camera: it is drawn enlarged to
+    the largest size, and its title says by how much.
 
     Returns
     -------
@@ -844,7 +937,21 @@ def side_by_side(*views, link_cameras=True):
     distance = None
     if link_cameras and len(views) > 1:
         first = views[0]
-        radius = max(v._radius for v in views)
+        groups = []                               # views of one mesh: (radius, [views])
+        for v in views:
+            for group in groups:
+                if np.array_equal(group[1][0]._F, v._F):
+                    group[1].append(v)
+                    break
+            else:
+                groups.append([0.0, [v]])
+        for group in groups:
+            group[0] = max(v._radius for v in group[1])
+        radius = max(r for r, _ in groups)
+        for r, members in groups:
+            scale = radius / r if r < SPECK_RATIO * radius else 1.0
+            for v in members:
+                v._set_scale(scale)
         distance = _camera_distance(radius, first.width, first.height)
         cam = first.camera
         cam.position = tuple(float(x) for x in _basis(first._direction, first._up)[2] * distance)

@@ -324,3 +324,77 @@ def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
     G[0] = G[0, ::-1]                                                       # one face flipped
     assert MeshView(V, G).mesh.material.side == "DoubleSide"
     assert MeshView(V, F[1:]).mesh.material.side == "DoubleSide"            # a hole
+
+
+# --- pictures that must not mislead ----------------------------------------
+
+def test_a_field_zero_up_to_rounding_draws_white(sphere):
+    from geomlib.viewer import ZERO_COLOR
+
+    V, F = sphere
+    rounding = 8e-13 * np.sin(7 * V[:, 0])              # a flat mesh's H, say: zero but for rounding
+    view = MeshView(V, F, values=rounding, symmetric=True, label="H (1/length)")
+    assert view.is_zero
+    np.testing.assert_array_equal(view.colors, np.tile(np.float32(ZERO_COLOR), (len(V), 1)))
+    assert "0 everywhere" in view._colorbar.value and "linear-gradient" not in view._colorbar.value
+    assert "0 everywhere" in view.summary() and "RdBu_r" not in view.summary()
+    # a field above the tolerance is coloured as usual, over its own range
+    view.update(values=1e-3 * np.sin(7 * V[:, 0]))
+    assert not view.is_zero and "linear-gradient" in view._colorbar.value
+    assert len(np.unique(view.colors, axis=0)) > 50
+    # the tolerance is the caller's to set: 0 colours even rounding noise
+    assert not MeshView(V, F, values=rounding, symmetric=True, zero_tol=0.0).is_zero
+
+
+def test_zero_field_keeps_nan_grey(sphere):
+    V, F = sphere
+    values = np.zeros(len(V))
+    values[:5] = np.nan
+    view = MeshView(V, F, values=values)
+    assert view.is_zero
+    np.testing.assert_allclose(view.colors[:5], [NAN_COLOR] * 5, atol=1e-6)
+    np.testing.assert_allclose(view.colors[5:], 1.0)
+
+
+def test_frame_keeps_a_collapsed_mesh_at_the_input_scale(sphere):
+    V, F = sphere
+    collapsed = 0.01 * V + 0.3                            # what a collapsing flow leaves
+    own = MeshView(collapsed, F)
+    framed = MeshView(collapsed, F, frame=V)
+    assert framed._distance == pytest.approx(MeshView(V, F)._distance)
+    assert own._distance == pytest.approx(0.01 * framed._distance)
+    # in the still, the collapsed mesh covers a small fraction of what the input covers
+    def covered(view):
+        return np.any(view.still()[:view.height] < 245, axis=2).mean()
+    assert covered(framed) < 0.01 * covered(MeshView(V, F))
+    assert covered(own) > 0.5 * covered(MeshView(V, F))
+    # updating to the collapsed positions does not reframe either
+    view = MeshView(V, F)
+    distance = view._distance
+    view.update(V=collapsed)
+    assert view._distance == distance and covered(view) < 0.01 * covered(MeshView(V, F))
+
+
+def test_linked_views_of_very_different_sizes_are_not_specks(sphere):
+    V, F = sphere
+    big = 28.0 * V                                        # fandisk_ns is 28 times plane_ns
+    small_V, small_F = V[:, :], F[:, ::-1].copy()         # another mesh (other faces)
+    a, b = MeshView(big, F, title="large"), MeshView(small_V, small_F, title="small")
+    row = side_by_side(a, b)
+    assert a._scale == 1.0 and b._scale == pytest.approx(28.0)
+    assert b.mesh.scale == pytest.approx((28.0, 28.0, 28.0))
+    assert "28 x larger" in b._title.value and "larger" not in a._title.value
+    assert "28 x larger" in b.summary()
+    covered = [np.any(v.still(distance=row._distance)[18:18 + v.height] < 245, axis=2).mean() for v in row.views]
+    assert covered[1] > 0.5 * covered[0]
+
+
+def test_linked_views_of_one_mesh_keep_their_common_scale(sphere):
+    V, F = sphere
+    before, after = MeshView(V, F), MeshView(0.05 * V, F)   # the same mesh before and after shrinking
+    side_by_side(before, after)
+    assert before._scale == after._scale == 1.0
+    # similar sizes are never rescaled
+    c, d = MeshView(V, F), MeshView(0.5 * V, F[:, ::-1].copy())
+    side_by_side(c, d)
+    assert c._scale == d._scale == 1.0

@@ -1,0 +1,50 @@
+"""geomlib.filters: the per-mode factor of each smoothing step, against its formula and the
+inequalities the notebooks quote (1/(1 + x) > exp(-x) > 1 - x for x > 0)."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+
+from geomlib.filters import SCHEMES, mode_factor, plot_mode_factors
+
+
+def test_factors_at_known_points():
+    lam = np.array([0.0, 1.0, 2.0, 4.0])
+    tau = 0.5
+    np.testing.assert_allclose(mode_factor(lam, tau, "explicit"), [1.0, 0.5, 0.0, -1.0])
+    np.testing.assert_allclose(mode_factor(lam, tau, "implicit"), [1.0, 2 / 3, 0.5, 1 / 3])
+    np.testing.assert_allclose(mode_factor(lam, tau, "crank-nicolson"), [1.0, 0.6, 1 / 3, 0.0])
+    np.testing.assert_allclose(mode_factor(lam, tau, "diffusion"), np.exp(-tau * lam))
+    np.testing.assert_allclose(mode_factor(lam, tau, "taubin", tau_inflate=-0.6),
+                               (1 - 0.5 * lam) * (1 + 0.6 * lam))
+
+
+def test_implicit_is_weaker_than_diffusion_and_explicit_stronger():
+    x = np.geomspace(1e-3, 1e3, 200)
+    implicit, diffusion, explicit = (mode_factor(x, 1.0, s) for s in ("implicit", "diffusion", "explicit"))
+    assert (implicit > diffusion).all() and (diffusion > explicit).all()
+    # the explicit step stays in [-1, 1] exactly up to tau lam = 2; the implicit and CN ones always
+    assert (np.abs(explicit[x <= 2]) <= 1).all() and (np.abs(explicit[x > 2]) > 1).all()
+    assert (np.abs(mode_factor(x, 1.0, "crank-nicolson")) <= 1).all() and (implicit > 0).all()
+
+
+def test_taubin_keeps_low_frequencies_and_needs_its_signs():
+    lam = np.array([0.0, 1e-3])
+    f = mode_factor(lam, 0.5, "taubin", tau_inflate=-0.53)
+    assert f[0] == 1.0 and f[1] > 1.0 - 1e-4                 # the pass band is (nearly) untouched
+    with pytest.raises(ValueError, match="tau_inflate < 0"):
+        mode_factor(lam, 0.5, "taubin", tau_inflate=0.5)
+    with pytest.raises(ValueError, match="scheme must be one of"):
+        mode_factor(lam, 0.5, "heun")
+
+
+def test_plot_draws_every_scheme_and_the_eigenvalue_band():
+    ax = plot_mode_factors(2.0, 50.0, 0.01, taubin=(0.01, -0.0105))
+    labels = [line.get_label() for line in ax.get_lines()]
+    for scheme in SCHEMES[:-1]:
+        assert scheme in labels
+    assert any(label.startswith("Taubin") for label in labels)
+    assert len(ax.patches) == 1 and ax.patches[0].get_label() == "this mesh's eigenvalues"

@@ -1,0 +1,81 @@
+"""Notebooks 05 and 06 with a reader's inputs: the course's meshes with the assignment's own absolute
+steps, the awkward meshes readers bring, and every parameter at an end of its documented range.
+
+No run may raise; the notes a run shows must name the cause. Each run combines several parameters,
+so that the module exercises the notebooks' different code paths (open and closed meshes, several
+components, a large CUBE, steps past every limit, absolute and scale-free units) in a few runs.
+"""
+
+import pytest
+
+from awkward_meshes import make_all
+from meshdata import COURSE, needs_course
+from notebook_runner import run_notebook
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def awkward(tmp_path_factory):
+    return {name: str(path) for name, path in make_all(tmp_path_factory.mktemp("awkward")).items()}
+
+
+def notes_of(run):
+    return "\n".join(run.notes)
+
+
+@needs_course
+def test_05_course_meshes_with_the_assignments_absolute_step():
+    run = run_notebook("05_explicit_smoothing.ipynb", PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+                       PART=str(COURSE / "smoothing" / "fandisk_ns.obj"), STEP=1e-5, STEP_UNIT="length^2",
+                       BREAK_MARGIN=0.3, BREAK_ITERATIONS=20, ITERATIONS=0, CUBE_STEPS=1)
+    run.assert_ran()
+    text, notes = run.outputs_text(), notes_of(run)
+    # the conversion table: 1e-5 is 0.0278 of fandisk_ns's limit and 2.1 times plane_ns's
+    assert "| part | assignment's 1e-05 | 1e-05 | 0.000833 | 0.02782 |" in text
+    assert "| plane | assignment's 1e-06 | 1e-06 | 0.03545 | 0.2118 |" in text
+    assert "past the cotangent limit on plane" in notes
+    # the fixed boundary: the raw top coefficient settles instead of decaying, and the text says why
+    assert "settles" in text and "fixed boundary vertices" in text
+    # plane_ns is a regular grid: uniform weights have nothing to slide, and the note says so
+    assert "a regular grid, with equal valences and equal triangles, has nothing to even out" in notes
+    assert "PART's diagonal is 28.2 times PLANE's" in text
+    assert len(run.notes) == 2, run.notes        # the step past plane_ns's limit, and the regular grid
+
+
+def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
+    run = run_notebook("05_explicit_smoothing.ipynb", PLANE=awkward["y_up_millimetres"],
+                       PART=awkward["two_components"], CUBE=awkward["cad_part"], STEP=0.5,
+                       BREAK_MARGIN=0.005, BREAK_ITERATIONS=1000, ITERATIONS=1000, CUBE_STEPS=50)
+    run.assert_ran()
+    notes = notes_of(run)
+    assert "2 connected components" in notes and "largest_component" in notes
+    assert "CUBE has 6209 vertices" in notes
+    assert "past the cotangent limit on cube, plane, part" in notes
+    assert "STEP is 1.84 times PART's limit" in notes
+    assert "CUBE may not be the 8-vertex cube" in notes
+    assert "a PLANE that is not flat" in notes
+
+
+@needs_course
+def test_06_course_meshes_with_the_assignments_absolute_step():
+    run = run_notebook("06_implicit_smoothing.ipynb", PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+                       PART=str(COURSE / "smoothing" / "fandisk_ns.obj"), STEP=1e-5, STEP_UNIT="length^2",
+                       ITERATIONS=1, SMOOTHING_TIME=0.1)
+    run.assert_ran()
+    text = run.outputs_text()
+    assert "| part | assignment's 1e-05 | | | | 1e-05 | 0.000833 | 0.02782 |" in text
+    # T = 0.1 ell^2 takes 4 explicit steps, each near the limit: they damp the top mode less than usual
+    assert len(run.notes) == 1 and "near the limit an explicit step damps the top mode only by" in run.notes[0]
+
+
+def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
+    run = run_notebook("06_implicit_smoothing.ipynb", PLANE=awkward["scan_with_holes"],
+                       PART=awkward["scan_with_holes"], CUBE=awkward["two_components"],
+                       SPHERE=awkward["y_up_millimetres"], STEP=100.0, ITERATIONS=50, SMOOTHING_TIME=100.0)
+    run.assert_ran()
+    notes = notes_of(run)
+    assert "not used by any face" in notes and "remove_unreferenced_vertices" in notes
+    assert "2 connected components" in notes and "largest_component" in notes
+    assert "PART is open: it encloses no volume" in notes
+    assert "where PLANE is not a noisy plane" in notes
