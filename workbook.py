@@ -30,6 +30,9 @@ VENV = ROOT / ".venv"
 BIN = VENV / ("Scripts" if os.name == "nt" else "bin")
 PY = BIN / ("python.exe" if os.name == "nt" else "python")
 STAMP = VENV / ".workbook-stamp"
+# the tested package set and geomlib with its front-end and test extras
+# (environment.yml's pip section says the same; tests/test_environment.py checks it)
+INSTALL_ARGS = ["-c", "constraints.txt", "-e", ".[dev,lab]"]
 
 
 def _fingerprint():
@@ -63,7 +66,7 @@ def ensure_environment():
     if not STAMP.exists() or STAMP.read_text() != fingerprint:
         print("Installing the pinned packages (first run takes a few minutes) ...", flush=True)
         _run([PY, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
-        _run([PY, "-m", "pip", "install", "--quiet", "-c", "constraints.txt", "-e", ".[dev,lab]"])
+        _run([PY, "-m", "pip", "install", "--quiet", *INSTALL_ARGS])
         _lab_settings()
         STAMP.write_text(fingerprint)
 
