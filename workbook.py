@@ -47,13 +47,16 @@ def _run(cmd, **kw):
     subprocess.run([str(c) for c in cmd], check=True, cwd=ROOT, **kw)
 
 
+# JupyterLab and Notebook 7 settings for .venv: no news or update pop-up for a
+# newcomer to dismiss (it also covers the notebook in screenshots)
+LAB_OVERRIDES = {"@jupyterlab/apputils-extension:notification": {"fetchNews": "false",
+                                                                 "checkForUpdates": False}}
+
+
 def _lab_settings():
-    """Quiet JupyterLab's news pop-up (it covers the notebook in screenshots)."""
     folder = VENV / "share" / "jupyter" / "lab" / "settings"
     folder.mkdir(parents=True, exist_ok=True)
-    overrides = {"@jupyterlab/apputils-extension:notification": {"fetchNews": "false",
-                                                                  "checkForUpdates": False}}
-    (folder / "overrides.json").write_text(json.dumps(overrides, indent=2))
+    (folder / "overrides.json").write_text(json.dumps(LAB_OVERRIDES, indent=2))
 
 
 def ensure_environment():
