@@ -62,8 +62,9 @@ class LabServer:
     """A JupyterLab (``app="lab"``) or Notebook 7 (``app="notebook"``) server
     serving a temporary copy of ``notebook_dir``.
 
-    ``user_settings`` replaces LAB_SETTINGS, ``overrides`` is written as the
-    installation's ``lab/settings/overrides.json``, ``args`` go to the app.
+    ``user_settings`` replaces LAB_SETTINGS; ``overrides`` replaces the
+    installation's ``share/jupyter/lab/settings/overrides.json`` (the file
+    workbook.py writes into .venv); ``args`` go to the app.
     """
 
     def __init__(self, notebook_dir, startup_timeout=90, app="lab", user_settings=None, overrides=None,
@@ -97,10 +98,11 @@ class LabServer:
             env[key] = str(self.tmp / sub)
         env.pop("JUPYTER_PATH", None)
         env["PYTHONNOUSERSITE"] = "1"
-        if self.overrides is not None:
-            (self.tmp / "data" / "lab" / "settings").mkdir(parents=True)
-            (self.tmp / "data" / "lab" / "settings" / "overrides.json").write_text(json.dumps(self.overrides))
         module, app_class, _ = APPS[self.app]
+        if self.overrides is not None:
+            (self.tmp / "app-settings").mkdir()
+            (self.tmp / "app-settings" / "overrides.json").write_text(json.dumps(self.overrides))
+            self.args.append(f"--{app_class}.app_settings_dir={self.tmp / 'app-settings'}")
         cmd = [
             sys.executable, "-m", module, "--no-browser",
             "--ServerApp.ip=127.0.0.1", f"--ServerApp.port={self.port}",

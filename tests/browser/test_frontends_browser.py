@@ -8,7 +8,8 @@
 * First contact: the address `workbook.py lab` and `workbook.py notebook`
   open lands on notebook 00, with no dialog and no pop-up (such as
   JupyterLab's question about news) for a newcomer to dismiss. The server
-  gets the settings workbook.py installs and no user settings at all.
+  gets the settings workbook.py installs (and only those: its own
+  installation-wide settings folder) and no user settings at all.
 
 Screenshots: build/screenshots/NAME/.
 """
@@ -25,7 +26,8 @@ ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOK_DIR = ROOT / "notebooks"
 RUN_TIMEOUT = 180          # seconds for one notebook to run top to bottom
 RENDER_TIMEOUT = 30        # seconds for a view to draw / react to a slider
-SETTLE = 5                 # seconds a newcomer's page is watched for pop-ups
+WATCH = 25                 # seconds a newcomer's page is watched for pop-ups (JupyterLab asks
+                           # about news some 10-15 s after start-up when nothing answered it)
 
 pytestmark = pytest.mark.browser
 
@@ -112,8 +114,7 @@ def _first_contact(browser, server):
         page.goto(f"{server.url}/?token={server.token}", wait_until="domcontentloaded", timeout=120_000)
         page.wait_for_function(JS_OPEN_DOCUMENT, timeout=120_000, polling=250)
         opened = page.evaluate(JS_OPEN_DOCUMENT)
-        time.sleep(SETTLE)
-        interruptions = page.evaluate(JS_INTERRUPTIONS)
+        interruptions = _wait_for(lambda: page.evaluate(JS_INTERRUPTIONS), WATCH, interval=0.5)
         page.screenshot(path=str(_screenshots(f"first_contact_{server.app}") / "page.png"))
         return opened, interruptions
     finally:
