@@ -133,3 +133,16 @@ def test_tested_python_is_declared_and_stated_in_the_readme():
     readme = (ROOT / "README.md").read_text()
     assert f"tested with Python {tested}" in readme
     assert f'requires-python = "{_project()["requires-python"]}"' in readme
+
+
+def test_workbook_opens_notebook_00_and_passes_arguments_on():
+    workbook = _workbook()
+    lab = workbook.front_end_command("lab", ["--port", "8899"])
+    notebook = workbook.front_end_command("notebook", ["--port", "8899"], root=True)
+    assert lab[1:3] == ["lab", "--notebook-dir"] and notebook[1:3] == ["notebook", "--notebook-dir"]
+    assert "--LabApp.default_url=/lab/tree/00_getting_started.ipynb" in lab
+    assert "--JupyterNotebookApp.default_url=/notebooks/00_getting_started.ipynb" in notebook
+    assert lab[-2:] == ["--port", "8899"] and "--allow-root" not in lab
+    assert notebook[-3:] == ["--port", "8899", "--allow-root"]
+    assert workbook.front_end_command("lab", ["--allow-root"], root=True).count("--allow-root") == 1
+    assert (workbook.NOTEBOOKS / workbook.FIRST_NOTEBOOK).is_file()
