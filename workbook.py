@@ -1,15 +1,18 @@
 #!/usr/bin/env python3
 """Set up and run the workbook: the two commands of the README.
 
-    python3 workbook.py lab     # JupyterLab on notebooks/ (creates .venv first if needed)
-    python3 workbook.py test    # every test: unit, notebooks (nbval), browser
-    python3 workbook.py assignment   # the assignment version in build/assignment/
+    python3 workbook.py lab        # JupyterLab on notebooks/, opened at notebook 00
+    python3 workbook.py notebook   # the same in Jupyter Notebook 7 instead of JupyterLab
+    python3 workbook.py test       # every test: unit, notebooks (nbval), browser
+    python3 workbook.py assignment # the assignment version in build/assignment/
+    python3 workbook.py setup      # only create or update .venv
 
-Both create the virtual environment ``.venv`` beside this file when it is
-missing, and (re)install the pinned package set (``constraints.txt``) when
+Each creates the virtual environment ``.venv`` beside this file when it is
+missing, and (re)installs the pinned package set (``constraints.txt``) when
 ``pyproject.toml`` or ``constraints.txt`` changed since the last install.
-Needs only Python 3.10-3.13 with its standard ``venv`` module.
-Extra arguments after ``test`` go to pytest, after ``lab`` to JupyterLab.
+Needs only Python 3.11 or newer with its standard ``venv`` module.
+Extra arguments after ``test`` go to pytest, after ``lab`` to JupyterLab,
+after ``notebook`` to Jupyter Notebook.
 """
 
 import hashlib
@@ -21,10 +24,15 @@ import venv
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent
+NOTEBOOKS = ROOT / "notebooks"
+FIRST_NOTEBOOK = "00_getting_started.ipynb"
 VENV = ROOT / ".venv"
 BIN = VENV / ("Scripts" if os.name == "nt" else "bin")
 PY = BIN / ("python.exe" if os.name == "nt" else "python")
 STAMP = VENV / ".workbook-stamp"
+# the tested package set and geomlib with its front-end and test extras
+# (environment.yml's pip section says the same; tests/test_environment.py checks it)
+INSTALL_ARGS = ["-c", "constraints.txt", "-e", ".[dev,lab]"]
 
 
 def _fingerprint():
@@ -39,18 +47,21 @@ def _run(cmd, **kw):
     subprocess.run([str(c) for c in cmd], check=True, cwd=ROOT, **kw)
 
 
+# JupyterLab and Notebook 7 settings for .venv: no news or update pop-up for a
+# newcomer to dismiss (it also covers the notebook in screenshots)
+LAB_OVERRIDES = {"@jupyterlab/apputils-extension:notification": {"fetchNews": "false",
+                                                                 "checkForUpdates": False}}
+
+
 def _lab_settings():
-    """Quiet JupyterLab's news pop-up (it covers the notebook in screenshots)."""
     folder = VENV / "share" / "jupyter" / "lab" / "settings"
     folder.mkdir(parents=True, exist_ok=True)
-    overrides = {"@jupyterlab/apputils-extension:notification": {"fetchNews": "false",
-                                                                  "checkForUpdates": False}}
-    (folder / "overrides.json").write_text(json.dumps(overrides, indent=2))
+    (folder / "overrides.json").write_text(json.dumps(LAB_OVERRIDES, indent=2))
 
 
 def ensure_environment():
-    if sys.version_info < (3, 10):
-        sys.exit(f"Python 3.10 or newer is needed; this is {sys.version.split()[0]}")
+    if sys.version_info < (3, 11):
+        sys.exit(f"Python 3.11 or newer is needed; this is {sys.version.split()[0]}")
     if not PY.exists():
         print(f"Creating the virtual environment in {VENV.name}/ ...", flush=True)
         venv.EnvBuilder(with_pip=True).create(VENV)
@@ -58,13 +69,28 @@ def ensure_environment():
     if not STAMP.exists() or STAMP.read_text() != fingerprint:
         print("Installing the pinned packages (first run takes a few minutes) ...", flush=True)
         _run([PY, "-m", "pip", "install", "--quiet", "--upgrade", "pip"])
-        _run([PY, "-m", "pip", "install", "--quiet", "-c", "constraints.txt", "-e", ".[dev]"])
+        _run([PY, "-m", "pip", "install", "--quiet", *INSTALL_ARGS])
         _lab_settings()
         STAMP.write_text(fingerprint)
 
 
+def front_end_command(app, args, root=False):
+    """The command line that opens notebooks/ in ``app`` ("lab" or "notebook").
+
+    The browser opens at notebook 00 (the app's default URL), so a newcomer
+    lands on the first lesson; ``args`` go to the app unchanged.
+    """
+    first = "/lab/tree/" if app == "lab" else "/notebooks/"
+    app_class = "LabApp" if app == "lab" else "JupyterNotebookApp"
+    cmd = [BIN / "jupyter", app, "--notebook-dir", NOTEBOOKS,
+           f"--{app_class}.default_url={first}{FIRST_NOTEBOOK}", *args]
+    if root and "--allow-root" not in args:
+        cmd.append("--allow-root")  # containers and CI machines often run as root
+    return [str(c) for c in cmd]
+
+
 def main(argv):
-    if not argv or argv[0] not in ("lab", "test", "setup", "assignment"):
+    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment"):
         print(__doc__)
         return 2
     command, rest = argv[0], argv[1:]
@@ -75,12 +101,10 @@ def main(argv):
         return 0
     if command == "assignment":
         return subprocess.call([str(PY), str(ROOT / "tools" / "build_assignment.py"), *rest], cwd=ROOT, env=env)
-    if command == "lab":
-        cmd = [BIN / "jupyter", "lab", "--notebook-dir", ROOT / "notebooks", *rest]
-        if hasattr(os, "geteuid") and os.geteuid() == 0 and "--allow-root" not in rest:
-            cmd.append("--allow-root")  # containers and CI machines often run as root
-        print("+", " ".join(str(c) for c in cmd), flush=True)
-        return subprocess.call([str(c) for c in cmd], cwd=ROOT / "notebooks", env=env)
+    if command in ("lab", "notebook"):
+        cmd = front_end_command(command, rest, root=hasattr(os, "geteuid") and os.geteuid() == 0)
+        print("+", " ".join(cmd), flush=True)
+        return subprocess.call(cmd, cwd=NOTEBOOKS, env=env)
     cmd = [PY, "-m", "pytest", *rest]
     print("+", " ".join(str(c) for c in cmd), flush=True)
     return subprocess.call([str(c) for c in cmd], cwd=ROOT, env=env)

@@ -23,6 +23,7 @@ from importlib import import_module
 from .errors import MeshError, MeshWarning
 
 __version__ = "0.1.0"
+import_module(".frontends", __name__).enable_colab_widgets()  # Colab draws the 3D views only after this
 
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {

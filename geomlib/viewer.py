@@ -86,18 +86,23 @@ the colour bar) and a one-line text summary, so nbval, exported HTML and
 repository previews still show the mesh. (``jupyter nbconvert --to html``
 shows the still unless the notebook was saved with its widget state; with the
 state it embeds the live widget, which needs the widget scripts from a CDN.)
+A view shown inside an ipywidgets box (``VBox([slider, view.widget])``) is
+drawn too: importing this module in IPython gives every box holding views a
+still picture of them (``box_still``), side by side.
 """
 
 import base64
 import html
 import io
+import weakref
 
 import numpy as np
 import scipy.sparse as sp
 
 from .errors import MeshError, format_indices
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fast", "render_still"]
+__all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fast", "render_still",
+           "box_still"]
 
 #: colour of vertices whose value is NaN (RGB in [0, 1])
 NAN_COLOR = (0.62, 0.62, 0.62)
@@ -696,6 +701,7 @@ class MeshView:
         self.widget = widgets.VBox([self._title, self.renderer, self._colorbar],
                                    layout=widgets.Layout(width="auto", align_items="flex-start"))
         self.widget.add_class("geomlib-view")
+        _SHOWN[self.widget.model_id] = self
 
     # -- state ---------------------------------------------------------------
 
@@ -887,17 +893,11 @@ class ViewRow:
         self.views = list(views)
         self.widget = widget
         self._distance = distance
+        _SHOWN[widget.model_id] = self
 
     def still(self):
         """(h, w, 3) uint8: the still pictures of the views next to each other."""
-        images = [v.still(distance=self._distance) for v in self.views]
-        h = max(im.shape[0] for im in images)
-        gap = np.full((h, 8, 3), 255, dtype=np.uint8)
-        parts = []
-        for im in images:
-            pad = np.full((h - im.shape[0], im.shape[1], 3), 255, dtype=np.uint8)
-            parts += [np.vstack([im, pad]), gap]
-        return np.hstack(parts[:-1])
+        return _in_a_row([v.still(distance=self._distance) for v in self.views])
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
         bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
@@ -907,6 +907,61 @@ class ViewRow:
 
     def __repr__(self):
         return "<ViewRow of " + "; ".join(v.summary() for v in self.views) + ">"
+
+
+# widget model id -> the MeshView or ViewRow that made the widget (weak: a
+# view the notebook dropped is not kept alive for its picture)
+_SHOWN = weakref.WeakValueDictionary()
+
+
+def _in_a_row(images):
+    h = max(im.shape[0] for im in images)
+    gap = np.full((h, 8, 3), 255, dtype=np.uint8)
+    parts = []
+    for im in images:
+        pad = np.full((h - im.shape[0], im.shape[1], 3), 255, dtype=np.uint8)
+        parts += [np.vstack([im, pad]), gap]
+    return np.hstack(parts[:-1])
+
+
+def box_still(box):
+    """Still picture of the views inside an ipywidgets box, or None if it holds none.
+
+    Every MeshView or side_by_side row found in ``box`` (at any depth) gives
+    its still picture; they are placed next to each other, (h, w, 3) uint8.
+    Sliders and other controls are not drawn.
+    """
+    images = []
+
+    def collect(widget):
+        shown = _SHOWN.get(getattr(widget, "model_id", None))
+        if shown is not None:
+            images.append(shown.still())
+            return
+        for child in getattr(widget, "children", ()):
+            collect(child)
+
+    collect(box)
+    return _in_a_row(images) if images else None
+
+
+def _box_png(box):
+    image = box_still(box)
+    return None if image is None else _png(image)
+
+
+def _give_boxes_stills():
+    """In IPython, display every ipywidgets box with the still of its views as image/png."""
+    from IPython import get_ipython
+
+    shell = get_ipython()
+    if shell is not None:
+        import ipywidgets
+
+        shell.display_formatter.formatters["image/png"].for_type(ipywidgets.Box, _box_png)
+
+
+_give_boxes_stills()
 
 
 def side_by_side(*views, link_cameras=True):

@@ -1,51 +1,44 @@
-"""The set-up files agree with each other: environment.yml (conda) names the
-same packages with the same version specifiers as pyproject.toml (pip), and
-constraints.txt pins every one of them to a version inside its range."""
+"""The set-up files ask for what they should.
 
+* pyproject.toml: the package requires the libraries geomlib and the notebooks
+  import, as ranges; the front-end (JupyterLab, Notebook, the kernel and the
+  widget packages) is pinned only in the ``lab`` extra, so installing geomlib
+  into a working Jupyter leaves that Jupyter alone.
+* constraints.txt pins every declared package exactly, inside its range; the
+  ``lab`` extra's pins are the same.
+* environment.yml asks conda only for Python and pip (packages conda-forge has
+  under those names) and pip for exactly what workbook.py installs.
+* The Python version tested (environment.yml, README) is one the package declares.
+"""
+
+import importlib.util
 import re
 import tomllib
 from pathlib import Path
 
 import yaml
 from packaging.requirements import Requirement
+from packaging.specifiers import SpecifierSet
 from packaging.utils import canonicalize_name
 
 ROOT = Path(__file__).resolve().parents[1]
+FRONT_END = {"jupyterlab", "notebook", "ipykernel", "ipywidgets", "jupyterlab-widgets",
+             "widgetsnbextension", "pythreejs", "ipydatawidgets"}
+# packages the front-end installs that must not be pinned by geomlib's own requirements
+NOT_REQUIRED = {"jupyterlab", "notebook", "ipykernel", "jupyterlab-widgets", "widgetsnbextension"}
+# what environment.yml may ask conda for: conda-forge packages of exactly these names
+CONDA_FORGE = {"python", "pip"}
 
 
-def _pyproject_requirements():
-    data = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    reqs = list(data["project"]["dependencies"])
-    for extra in data["project"]["optional-dependencies"].values():
-        reqs += extra
-    return {canonicalize_name(Requirement(r).name): Requirement(r).specifier for r in reqs}
+def _project():
+    return tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
 
 
-def _conda_requirements():
-    env = yaml.safe_load((ROOT / "environment.yml").read_text())
-    out = {}
-    for dep in env["dependencies"]:
-        if not isinstance(dep, str):
-            continue
-        name, spec = re.match(r"^([A-Za-z0-9_.\-]+)\s*(.*)$", dep).groups()
-        if name in ("python", "pip"):
-            continue
-        # conda writes a single '=' for "this version"; pip's '==' means the same
-        spec = re.sub(r"(?<![=<>!~])=(?!=)", "==", spec)
-        out[canonicalize_name(name)] = Requirement(f"{name}{spec}").specifier
-    return out
+def _requirements(lines):
+    return {canonicalize_name(Requirement(r).name): Requirement(r) for r in lines}
 
 
-def test_environment_yml_names_the_same_packages_as_pyproject():
-    pip, conda = _pyproject_requirements(), _conda_requirements()
-    assert sorted(pip) == sorted(conda), (
-        f"only in pyproject.toml: {sorted(set(pip) - set(conda))}; "
-        f"only in environment.yml: {sorted(set(conda) - set(pip))}")
-    differing = {name: (str(pip[name]), str(conda[name])) for name in pip if pip[name] != conda[name]}
-    assert not differing, f"version specifiers differ (pyproject, environment.yml): {differing}"
-
-
-def test_constraints_pin_every_declared_package_inside_its_range():
+def _pins():
     pins = {}
     for line in (ROOT / "constraints.txt").read_text().splitlines():
         line = line.strip()
@@ -54,15 +47,102 @@ def test_constraints_pin_every_declared_package_inside_its_range():
             (spec,) = list(req.specifier)
             assert spec.operator == "==", f"constraints.txt must pin exactly: {line}"
             pins[canonicalize_name(req.name)] = spec.version
-    for name, specifier in _pyproject_requirements().items():
+    return pins
+
+
+def _environment():
+    env = yaml.safe_load((ROOT / "environment.yml").read_text())
+    conda, pip = [], []
+    for dep in env["dependencies"]:
+        if isinstance(dep, dict):
+            assert set(dep) == {"pip"}, f"environment.yml: unexpected entry {dep}"
+            pip += dep["pip"]
+        else:
+            conda.append(dep)
+    return env, conda, pip
+
+
+def _workbook():
+    spec = importlib.util.spec_from_file_location("workbook", ROOT / "workbook.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_package_requirements_are_ranges_without_the_front_end():
+    required = _requirements(_project()["dependencies"])
+    pinned = {name: str(r.specifier) for name, r in required.items()
+              if any(s.operator in ("==", "===") for s in r.specifier)}
+    assert not pinned, f"exact pins in [project] dependencies (they belong in constraints.txt): {pinned}"
+    unbounded = [name for name, r in required.items() if not any(s.operator == "<" for s in r.specifier)]
+    assert not unbounded, f"give these an upper bound (next major release): {unbounded}"
+    assert not NOT_REQUIRED & set(required), (
+        f"the package requires front-end packages {sorted(NOT_REQUIRED & set(required))}; "
+        "they belong in the 'lab' extra")
+    # what the notebooks import for the views must still come with the package
+    assert {"ipywidgets", "pythreejs"} <= set(required)
+
+
+def test_constraints_pin_every_declared_package_inside_its_range():
+    pins = _pins()
+    project = _project()
+    declared = list(project["dependencies"])
+    for extra in project["optional-dependencies"].values():
+        declared += extra
+    for name, req in _requirements(declared).items():
         assert name in pins, f"{name} is declared in pyproject.toml but not pinned in constraints.txt"
-        assert specifier.contains(pins[name], prereleases=True), (
-            f"{name}=={pins[name]} in constraints.txt is outside {specifier} from pyproject.toml")
+        assert req.specifier.contains(pins[name], prereleases=True), (
+            f"{name}=={pins[name]} in constraints.txt is outside {req.specifier} from pyproject.toml")
 
 
-def test_widget_front_end_versions_are_pinned_together():
-    """The widget packages whose drift breaks the front-end are pinned exactly."""
-    pip = _pyproject_requirements()
-    for name in ("jupyterlab", "ipywidgets", "jupyterlab-widgets", "widgetsnbextension", "pythreejs"):
-        (spec,) = list(pip[name])
-        assert spec.operator == "==", f"{name} must be pinned exactly in pyproject.toml"
+def test_lab_extra_pins_the_front_end_as_constraints_do():
+    """The widget packages whose drift breaks the views are pinned together."""
+    lab = _requirements(_project()["optional-dependencies"]["lab"])
+    assert set(lab) == FRONT_END
+    pins = _pins()
+    for name, req in lab.items():
+        (spec,) = list(req.specifier)
+        assert spec.operator == "==" and spec.version == pins[name], (
+            f"geomlib[lab] asks for {name}{req.specifier}, constraints.txt pins {pins[name]}")
+
+
+def test_environment_yml_asks_conda_only_for_python_and_pip():
+    env, conda, _ = _environment()
+    assert env["channels"] == ["conda-forge"]
+    names = {re.match(r"[A-Za-z0-9_.\-]+", dep).group(0) for dep in conda}
+    assert names == CONDA_FORGE, f"conda is asked for {sorted(names)}; only {sorted(CONDA_FORGE)} are meant"
+
+
+def test_environment_yml_pip_section_installs_what_workbook_py_installs():
+    _, _, pip = _environment()
+    args = [word for line in pip for word in line.split()]
+    assert args == _workbook().INSTALL_ARGS
+    # the paths are relative to the folder of environment.yml (conda runs pip there)
+    constraints = args[args.index("-c") + 1]
+    assert (ROOT / constraints).is_file()
+    extras = re.fullmatch(r"\.\[([a-z,]+)\]", args[args.index("-e") + 1]).group(1).split(",")
+    assert set(extras) <= set(_project()["optional-dependencies"])
+    assert "--no-deps" not in args
+
+
+def test_tested_python_is_declared_and_stated_in_the_readme():
+    _, conda, _ = _environment()
+    (python,) = [dep for dep in conda if dep.startswith("python")]
+    tested = re.fullmatch(r"python\s*=\s*(\d+\.\d+)", python).group(1)
+    assert SpecifierSet(_project()["requires-python"]).contains(f"{tested}.0")
+    readme = (ROOT / "README.md").read_text()
+    assert f"tested with Python {tested}" in readme
+    assert f'requires-python = "{_project()["requires-python"]}"' in readme
+
+
+def test_workbook_opens_notebook_00_and_passes_arguments_on():
+    workbook = _workbook()
+    lab = workbook.front_end_command("lab", ["--port", "8899"])
+    notebook = workbook.front_end_command("notebook", ["--port", "8899"], root=True)
+    assert lab[1:3] == ["lab", "--notebook-dir"] and notebook[1:3] == ["notebook", "--notebook-dir"]
+    assert "--LabApp.default_url=/lab/tree/00_getting_started.ipynb" in lab
+    assert "--JupyterNotebookApp.default_url=/notebooks/00_getting_started.ipynb" in notebook
+    assert lab[-2:] == ["--port", "8899"] and "--allow-root" not in lab
+    assert notebook[-3:] == ["--port", "8899", "--allow-root"]
+    assert workbook.front_end_command("lab", ["--allow-root"], root=True).count("--allow-root") == 1
+    assert (workbook.NOTEBOOKS / workbook.FIRST_NOTEBOOK).is_file()

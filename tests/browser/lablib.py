@@ -1,4 +1,4 @@
-"""Drive JupyterLab in headless Chromium: shared by the browser tests and
+"""Drive JupyterLab (or Notebook 7) in headless Chromium: shared by the browser tests and
 benchmarks/bench_slider_latency.py.
 
 A server is started from this Python environment (``sys.executable -m
@@ -51,10 +51,28 @@ def free_port():
         return s.getsockname()[1]
 
 
-class LabServer:
-    """A JupyterLab server serving a temporary copy of ``notebook_dir``."""
+# app -> (Python module that starts it, its configuration class, URL of a notebook)
+APPS = {
+    "lab": ("jupyterlab", "LabApp", "/lab/tree/{name}?reset&token={token}"),
+    "notebook": ("notebook", "JupyterNotebookApp", "/notebooks/{name}?token={token}"),
+}
 
-    def __init__(self, notebook_dir, startup_timeout=90):
+
+class LabServer:
+    """A JupyterLab (``app="lab"``) or Notebook 7 (``app="notebook"``) server
+    serving a temporary copy of ``notebook_dir``.
+
+    ``user_settings`` replaces LAB_SETTINGS; ``overrides`` replaces the
+    installation's ``share/jupyter/lab/settings/overrides.json`` (the file
+    workbook.py writes into .venv); ``args`` go to the app.
+    """
+
+    def __init__(self, notebook_dir, startup_timeout=90, app="lab", user_settings=None, overrides=None,
+                 args=()):
+        self.app = app
+        self.user_settings = LAB_SETTINGS if user_settings is None else user_settings
+        self.overrides = overrides
+        self.args = list(args)
         self.source = Path(notebook_dir)
         self.startup_timeout = startup_timeout
         self.tmp = Path(tempfile.mkdtemp(prefix="geomlib-lab-"))
@@ -69,7 +87,7 @@ class LabServer:
         shutil.copytree(self.source, self.root,
                         ignore=shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__"))
         settings = self.tmp / "user-settings"
-        for rel, value in LAB_SETTINGS.items():
+        for rel, value in self.user_settings.items():
             path = settings / rel
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(json.dumps(value))
@@ -80,16 +98,22 @@ class LabServer:
             env[key] = str(self.tmp / sub)
         env.pop("JUPYTER_PATH", None)
         env["PYTHONNOUSERSITE"] = "1"
+        module, app_class, _ = APPS[self.app]
+        if self.overrides is not None:
+            (self.tmp / "app-settings").mkdir()
+            (self.tmp / "app-settings" / "overrides.json").write_text(json.dumps(self.overrides))
+            self.args.append(f"--{app_class}.app_settings_dir={self.tmp / 'app-settings'}")
         cmd = [
-            sys.executable, "-m", "jupyterlab", "--no-browser",
+            sys.executable, "-m", module, "--no-browser",
             "--ServerApp.ip=127.0.0.1", f"--ServerApp.port={self.port}",
             "--ServerApp.port_retries=0",
             f"--IdentityProvider.token={self.token}",
             f"--ServerApp.root_dir={self.root}",
-            f"--LabApp.user_settings_dir={settings}",
-            f"--LabApp.workspaces_dir={self.tmp / 'workspaces'}",
-            "--LabApp.expose_app_in_browser=True",
+            f"--{app_class}.user_settings_dir={settings}",
+            f"--{app_class}.workspaces_dir={self.tmp / 'workspaces'}",
+            f"--{app_class}.expose_app_in_browser=True",
             "--ServerApp.open_browser=False",
+            *self.args,
         ]
         if hasattr(os, "geteuid") and os.geteuid() == 0:
             cmd.append("--allow-root")   # containers and CI machines often run as root
@@ -116,7 +140,7 @@ class LabServer:
             return ""
 
     def notebook_url(self, name):
-        return f"{self.url}/lab/tree/{name}?reset&token={self.token}"
+        return self.url + APPS[self.app][2].format(name=name, token=self.token)
 
     def stop(self):
         if self.proc is not None and self.proc.poll() is None:
