@@ -4,6 +4,7 @@
     python3 workbook.py lab     # JupyterLab on notebooks/ (creates .venv first if needed)
     python3 workbook.py test    # every test: unit, notebooks (nbval), browser
     python3 workbook.py assignment   # the assignment version in build/assignment/
+    python3 workbook.py site    # the workbook as a static website in build/site/
 
 Both create the virtual environment ``.venv`` beside this file when it is
 missing, and (re)install the pinned package set (``constraints.txt``) when
@@ -64,7 +65,7 @@ def ensure_environment():
 
 
 def main(argv):
-    if not argv or argv[0] not in ("lab", "test", "setup", "assignment"):
+    if not argv or argv[0] not in ("lab", "test", "setup", "assignment", "site"):
         print(__doc__)
         return 2
     command, rest = argv[0], argv[1:]
@@ -75,6 +76,8 @@ def main(argv):
         return 0
     if command == "assignment":
         return subprocess.call([str(PY), str(ROOT / "tools" / "build_assignment.py"), *rest], cwd=ROOT, env=env)
+    if command == "site":
+        return subprocess.call([str(PY), str(ROOT / "tools" / "build_site.py"), *rest], cwd=ROOT, env=env)
     if command == "lab":
         cmd = [BIN / "jupyter", "lab", "--notebook-dir", ROOT / "notebooks", *rest]
         if hasattr(os, "geteuid") and os.geteuid() == 0 and "--allow-root" not in rest:
