@@ -87,7 +87,7 @@ KERNEL_NOTE = ("In JupyterLab this control recomputes the result; "
 # ---------------------------------------------------------------------------
 
 
-def _tarball(name, version, integrity):
+def fetch_tarball(name, version, integrity):
     """The package's tarball (bytes), from the cache or the registry, checked against ``integrity``."""
     algorithm, _, expected = integrity.partition("-")
     path = CACHE / f"{name.replace('/', '+')}-{version}.tgz"
@@ -111,7 +111,7 @@ def install_assets(site):
     """Unpack the kept files of every package of :data:`PACKAGES` into ``site/assets/``."""
     for name, (version, integrity, keep, folder) in PACKAGES.items():
         target = site / ASSETS / folder
-        with tarfile.open(fileobj=io.BytesIO(_tarball(name, version, integrity)), mode="r:gz") as tar:
+        with tarfile.open(fileobj=io.BytesIO(fetch_tarball(name, version, integrity)), mode="r:gz") as tar:
             for member in tar.getmembers():
                 rel = member.name.split("/", 1)[1]   # members sit under "package/"
                 if member.isfile() and any(fnmatch.fnmatchcase(rel, g) for g in keep):
@@ -244,7 +244,7 @@ def _exporter():
                         mathjax_url=MATHJAX)
 
 
-def _nav(pages, i):
+def nav_html(pages, i):
     def link(j, label):
         if 0 <= j < len(pages):
             return f'<a href="{pages[j]["file"]}">{label} {html.escape(pages[j]["title"])}</a>'
@@ -296,7 +296,7 @@ def build(out=OUT, names=None, log=print):
         log(f"  {pages[-1]['seconds']} s, {live} live 3D views")
     exporter = _exporter()
     for i, (page, nb) in enumerate(zip(pages, executed)):
-        body, _ = exporter.from_notebook_node(nb, resources={"site_nav": _nav(pages, i),
+        body, _ = exporter.from_notebook_node(nb, resources={"site_nav": nav_html(pages, i),
                                                              "metadata": {"name": page["title"]}})
         (out / page["file"]).write_text(body, encoding="utf-8")
     items = "\n".join(f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
