@@ -98,3 +98,13 @@ def test_every_package_is_pinned_exactly():
         assert version.count(".") == 2 and version.replace(".", "").isdigit(), name
         assert integrity.startswith("sha512-") and len(base64.b64decode(integrity[7:])) == 64, name
         assert keep and folder
+
+
+def test_cell_errors_are_listed():
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_markdown_cell("text"), nbformat.v4.new_code_cell("1 / 0")]
+    nb.cells[1].outputs = [nbformat.v4.new_output("error", ename="ZeroDivisionError",
+                                                  evalue="division by zero", traceback=[])]
+    assert build_site.cell_errors(nb) == ["cell 1: ZeroDivisionError: division by zero"]
+    nb.cells[1].outputs = []
+    assert build_site.cell_errors(nb) == []

@@ -127,14 +127,25 @@ def install_assets(site):
 
 
 def execute(path, timeout=1200):
-    """Run the notebook at ``path`` top to bottom in its folder; the widget state is stored."""
+    """Run the notebook at ``path`` top to bottom in its folder; the widget state is stored.
+
+    A cell that raises does not stop the run (the page shows the error, like
+    JupyterLab would); :func:`cell_errors` lists them.
+    """
     from nbclient import NotebookClient
 
     nb = nbformat.read(path, as_version=4)
     client = NotebookClient(nb, timeout=timeout, kernel_name="python3", store_widget_state=True,
-                            resources={"metadata": {"path": str(path.parent)}})
+                            allow_errors=True, resources={"metadata": {"path": str(path.parent)}})
     client.execute()
     return nb
+
+
+def cell_errors(nb):
+    """``"cell N: Name: message"`` for every error output of an executed notebook (N from 0)."""
+    return [f"cell {i}: {out.get('ename', '?')}: {out.get('evalue', '')}".strip()
+            for i, cell in enumerate(nb.cells) if cell.cell_type == "code"
+            for out in cell.get("outputs", []) if out.get("output_type") == "error"]
 
 
 def _references(value):
@@ -276,7 +287,8 @@ other controls recompute only in JupyterLab; here they show their default value.
 
 
 def build(out=OUT, names=None, log=print):
-    """Build the site into ``out``; returns a list of pages (file, title, live views, seconds)."""
+    """Build the site into ``out``; returns a list of pages (file, title, live views,
+    seconds, cell errors); the list is also written to ``out/pages.json``."""
     out = Path(out)
     paths = [NOTEBOOKS / n for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
     if out.exists():
@@ -291,9 +303,11 @@ def build(out=OUT, names=None, log=print):
         nb = execute(path)
         live = prepare_for_site(nb)
         pages.append({"file": path.stem + ".html", "title": title_of(nb, path.stem), "views": live,
-                      "seconds": round(time.perf_counter() - start, 1)})
+                      "seconds": round(time.perf_counter() - start, 1), "errors": cell_errors(nb)})
         executed.append(nb)
         log(f"  {pages[-1]['seconds']} s, {live} live 3D views")
+        for error in pages[-1]["errors"]:
+            log(f"  ERROR in {error}")
     exporter = _exporter()
     for i, (page, nb) in enumerate(zip(pages, executed)):
         body, _ = exporter.from_notebook_node(nb, resources={"site_nav": nav_html(pages, i),
@@ -322,8 +336,13 @@ def main(argv=None):
     size = folder_size(args.out)
     print(f"\nbuilt {args.out} in {time.perf_counter() - start:.0f} s, {size / 1e6:.1f} MB:")
     for p in pages:
-        print(f"  {p['file']:45s} {p['views']:2d} live 3D views")
+        errors = f", {len(p['errors'])} cell errors" if p["errors"] else ""
+        print(f"  {p['file']:45s} {p['views']:2d} live 3D views{errors}")
     print(f"open {Path(args.out) / 'index.html'} in a browser, or copy the folder to any static web host")
+    failed = [p["file"] for p in pages if p["errors"]]
+    if failed:
+        print(f"\ncells raised errors in {', '.join(failed)} (the pages show them); see above")
+        return 1
     return 0
 
 

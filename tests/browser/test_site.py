@@ -8,6 +8,7 @@ server on a loopback port; every request that goes anywhere else is aborted
 and recorded, and the test asserts that there was none.
 
 On every page:
+0. no cell raised an error while the notebook ran for the site;
 1. no request left the machine, and no file of the site is missing;
 2. every 3D view's canvas shows a picture (not one flat colour), as many
    canvases as the build counted live views;
@@ -192,6 +193,7 @@ def test_page_offline(notebook, site, site_url, browser):
     folder, pages = site
     name = Path(notebook).stem + ".html"
     assert name in pages, f"{name} was not built"
+    assert not pages[name]["errors"], "cells raised errors while the site was built:\n" + "\n".join(pages[name]["errors"])
     shots = SCREENSHOTS / Path(notebook).stem
     shots.mkdir(parents=True, exist_ok=True)
     view = OfflinePage(browser, site_url)
