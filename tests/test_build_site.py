@@ -3,6 +3,7 @@ for a static page, and the check of the pinned downloads."""
 
 import base64
 import hashlib
+import re
 import sys
 from pathlib import Path
 
@@ -108,3 +109,22 @@ def test_cell_errors_are_listed():
     assert build_site.cell_errors(nb) == ["cell 1: ZeroDivisionError: division by zero"]
     nb.cells[1].outputs = []
     assert build_site.cell_errors(nb) == []
+
+
+def test_page_loads_nothing_from_a_cdn_and_folds_hidden_code():
+    nb, _ = _notebook()
+    nb.cells.append(nbformat.v4.new_markdown_cell("A formula $\\Delta = M^{-1} C$."))
+    hidden = nbformat.v4.new_code_cell("explain('...')")
+    hidden.metadata["jupyter"] = {"source_hidden": True}
+    nb.cells.append(hidden)
+    build_site.prepare_for_site(nb)
+    nav = build_site.nav_html([{"file": "03.html", "title": "03"}], 0)
+    body, _ = build_site.exporter().from_notebook_node(nb, resources={"site_nav": nav})
+    # no script, style sheet or font from elsewhere (URLs in CSS comments are fine)
+    remote = re.findall(r"""(?:src=|href=|url\(|import\()\s*["']?(?:https?:)?//[^"')\s]+""", body)
+    assert not remote, remote[:3]
+    assert "unpkg.com" not in body and "cdnjs" not in body
+    assert f'src="{build_site.REQUIRE_JS}"' in body and build_site.WIDGET_RENDERER in body
+    assert build_site.MATHJAX.split("?")[0] in body
+    assert body.count('<details class="site-hidden-input">') == 1
+    assert body.count('class="site-nav"') == 1 and body.count('class="site-nav bottom"') == 1

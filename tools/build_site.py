@@ -231,9 +231,20 @@ nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding:
   font-family: var(--jp-ui-font-family); font-size: 14px; border-bottom: 1px solid #ddd; }
 nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
 p.site-kernel-note { font-style: italic; color: #555; margin: 0.2em 0; }
+details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 13px;
+  font-family: var(--jp-ui-font-family); margin: 0.3em 0 0.3em 6em; }
 </style>
 {%- endblock html_head_js_requirejs -%}
 {%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+{% block input_group -%}
+{%- if cell.metadata.get("jupyter", {}).get("source_hidden") -%}
+<details class="site-hidden-input"><summary>Show the code of this cell</summary>
+{{ super() }}
+</details>
+{%- else -%}
+{{ super() }}
+{%- endif -%}
+{% endblock input_group %}
 {%- block body_header -%}
 {{ super() }}
 {{ resources.site_nav }}
@@ -245,7 +256,7 @@ p.site-kernel-note { font-style: italic; color: #555; margin: 0.2em 0; }
 """
 
 
-def _exporter():
+def exporter():
     from jinja2 import DictLoader
     from nbconvert import HTMLExporter
 
@@ -308,9 +319,9 @@ def build(out=OUT, names=None, log=print):
         log(f"  {pages[-1]['seconds']} s, {live} live 3D views")
         for error in pages[-1]["errors"]:
             log(f"  ERROR in {error}")
-    exporter = _exporter()
+    page_exporter = exporter()
     for i, (page, nb) in enumerate(zip(pages, executed)):
-        body, _ = exporter.from_notebook_node(nb, resources={"site_nav": nav_html(pages, i),
+        body, _ = page_exporter.from_notebook_node(nb, resources={"site_nav": nav_html(pages, i),
                                                              "metadata": {"name": page["title"]}})
         (out / page["file"]).write_text(body, encoding="utf-8")
     items = "\n".join(f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
