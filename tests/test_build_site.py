@@ -52,11 +52,13 @@ def test_controls_are_disabled_and_noted():
     nb, state = _notebook()
     assert build_site.prepare_for_site(nb) == 2
     assert state["slider"]["state"]["disabled"] is True
-    first = nb.cells[0].outputs
-    assert len(first) == 2 and build_site.WIDGET_VIEW in first[0]["data"]
-    assert build_site.KERNEL_NOTE in first[1]["data"]["text/html"]
-    # no control in the second cell: no note
-    assert len(nb.cells[1].outputs) == 2
+    first = nb.cells[0].outputs       # view, its hidden still, the note
+    assert len(first) == 3 and build_site.WIDGET_VIEW in first[0]["data"]
+    assert 'class="site-still" hidden' in first[1]["data"]["text/html"]
+    assert "base64,iVBORw0KGgo=" in first[1]["data"]["text/html"]
+    assert build_site.KERNEL_NOTE in first[2]["data"]["text/html"]
+    # no control in the second cell: no note; the label has no still
+    assert len(nb.cells[1].outputs) == 3
     assert all("site-kernel-note" not in str(o) for o in nb.cells[1].outputs)
 
 

@@ -175,13 +175,19 @@ def _is_control(model):
     return model.get("model_module") == "@jupyter-widgets/controls" and "disabled" in model.get("state", {})
 
 
+def _html_output(text):
+    return nbformat.v4.new_output("display_data", data={"text/html": text})
+
+
 def prepare_for_site(nb):
     """Make an executed notebook fit for a static page (in place); returns the live view count.
 
     - every control is saved disabled (it cannot recompute without a kernel), and an
       output that holds one gets a one-line note after it;
     - an output whose widget was not saved loses its widget part, so its still
-      picture (image/png) or text is shown instead.
+      picture (image/png) or text is shown instead;
+    - a live 3D view keeps its still picture, hidden, after it: the page shows it
+      when the browser has no WebGL or the view did not appear (script in TEMPLATE).
     """
     state = nb.metadata.get("widgets", {}).get(WIDGET_STATE, {}).get("state", {})
     for model in state.values():
@@ -201,10 +207,13 @@ def prepare_for_site(nb):
             if not models:
                 del output["data"][WIDGET_VIEW]
                 continue
-            live += sum(state[m].get("model_name") == "RendererModel" for m in models)
+            renderers = sum(state[m].get("model_name") == "RendererModel" for m in models)
+            live += renderers
+            if renderers and "image/png" in output["data"]:
+                outputs.append(_html_output(f'<img class="site-still" hidden alt="still picture of the 3D view" '
+                                            f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'))
             if any(_is_control(state[m]) for m in models):
-                outputs.append(nbformat.v4.new_output(
-                    "display_data", data={"text/html": f'<p class="site-kernel-note">{html.escape(KERNEL_NOTE)}</p>'}))
+                outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(KERNEL_NOTE)}</p>'))
         cell.outputs = outputs
     return live
 
@@ -251,6 +260,27 @@ details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 1
 {%- endblock body_header -%}
 {% block body_footer %}
 {{ resources.site_nav.replace('class="site-nav"', 'class="site-nav bottom"') }}
+<script>
+// the still picture of a 3D view replaces nothing; it appears below the view when
+// the browser has no WebGL, or when the view has drawn no canvas 30 s after loading
+(function () {
+  function reveal(all) {
+    document.querySelectorAll("img.site-still").forEach(function (img) {
+      var child = img.closest(".jp-OutputArea-child");
+      var view = child && child.previousElementSibling;
+      if (all || !(view && view.querySelector("canvas"))) img.hidden = false;
+    });
+  }
+  var probe = document.createElement("canvas").getContext("webgl");
+  if (probe) {
+    var lose = probe.getExtension("WEBGL_lose_context");
+    if (lose) lose.loseContext();
+    window.addEventListener("load", function () { setTimeout(reveal, 30000, false); });
+  } else {
+    document.addEventListener("DOMContentLoaded", function () { reveal(true); });
+  }
+})();
+</script>
 {{ super() }}
 {% endblock body_footer %}
 """

@@ -13,6 +13,7 @@ On every page:
 2. every 3D view's canvas shows a picture (not one flat colour), as many
    canvases as the build counted live views;
 3. an orbit drag on every canvas changes its picture (no kernel involved);
+   (without WebGL, the still pictures are shown instead: a separate test);
 4. the formulas are typeset by the MathJax served from the site: MathJax
    output is present, no TeX error, no ``$$`` left in the text;
 5. every control that needs a kernel is disabled, and a note says so;
@@ -256,5 +257,33 @@ def test_page_from_file_url(site, browser):
         _check_canvases(view.page, pages[name]["views"], shots)
         assert not view.outside, f"requests to the network: {view.outside}"
         assert not view.errors, "console errors:\n" + "\n".join(view.errors)
+    finally:
+        view.close()
+
+
+NO_WEBGL = """
+const getContext = HTMLCanvasElement.prototype.getContext;
+HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {
+  return /webgl/.test(kind) ? null : getContext.call(this, kind, ...rest);
+};
+"""
+
+
+def test_stills_show_without_webgl(site, site_url, browser):
+    """In a browser without WebGL every 3D view's still picture is shown instead."""
+    folder, pages = site
+    name = next((f for f, p in pages.items() if p["views"]), None)
+    assert name, "no page has a live 3D view"
+    view = OfflinePage(browser, site_url)
+    try:
+        view.context.add_init_script(NO_WEBGL)
+        view.page.goto(site_url + name, wait_until="load")
+        stills = view.page.locator("img.site-still")
+        assert stills.count() > 0, "the page holds no still pictures of its views"
+        assert _wait_for(lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30), \
+            f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
+        for i in range(stills.count()):
+            assert _not_blank(lablib.stable_screenshot(stills.nth(i))), f"still {i} is blank"
+        assert not view.outside, f"requests to the network: {view.outside}"
     finally:
         view.close()
