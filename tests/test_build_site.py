@@ -130,3 +130,10 @@ def test_page_loads_nothing_from_a_cdn_and_folds_hidden_code():
     assert build_site.MATHJAX.split("?")[0] in body
     assert body.count('<details class="site-hidden-input">') == 1
     assert body.count('class="site-nav"') == 1 and body.count('class="site-nav bottom"') == 1
+
+
+def test_glob_patterns_of_kept_files():
+    one, deep = build_site.glob_pattern("extensions/*.js"), build_site.glob_pattern("jax/output/CommonHTML/**")
+    assert one.fullmatch("extensions/Safe.js") and not one.fullmatch("extensions/a11y/explorer.js")
+    assert deep.fullmatch("jax/output/CommonHTML/fonts/TeX/fontdata.js")
+    assert not deep.fullmatch("jax/output/SVG/jax.js")

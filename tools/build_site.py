@@ -23,7 +23,6 @@ build/npm-cache/ so later builds need no network.
 
 import argparse
 import base64
-import fnmatch
 import hashlib
 import html
 import io
@@ -45,7 +44,8 @@ CACHE = ROOT / "build" / "npm-cache"
 ASSETS = "assets"
 REGISTRY = "https://registry.npmjs.org"
 
-#: npm package -> (version, integrity, files kept (globs inside the package), folder in assets/).
+#: npm package -> (version, integrity, files kept, folder in assets/). The files kept are
+#: globs inside the package: ``*`` stays within one folder, ``**`` crosses folders.
 #: html-manager 1.0.x is the renderer of ipywidgets 8; jupyter-threejs 2.4.1 is the
 #: browser side of pythreejs 2.4.2 (its EXTENSION_SPEC_VERSION ^2.4.1),
 #: jupyter-datawidgets 5.5.2 that of ipydatawidgets 4.3.5.
@@ -55,8 +55,8 @@ PACKAGES = {
         ["require.js", "LICENSE"], "requirejs"),
     "@jupyter-widgets/html-manager": (
         "1.0.15", "sha512-5thBIV6ymNgmPVOHvzx+gGy8ZSKmSazhtGw4/c4xJDVzRhG9PTeQsRjF3FUTopvFi//SABeNz1yp47bCrJ3CQA==",
-        ["dist/embed-amd.js", "dist/*.woff2", "dist/*.woff", "dist/*.ttf", "dist/*.eot", "dist/*.svg",
-         "dist/*.LICENSE.txt", "LICENSE"], "html-manager"),
+        # its style sheet lists each icon font in several formats; browsers take the woff2
+        ["dist/embed-amd.js", "dist/*.woff2", "dist/*.woff", "dist/*.LICENSE.txt", "LICENSE"], "html-manager"),
     "jupyter-threejs": (
         "2.4.1", "sha512-AFoYllRmV5Hy1Hbyq8NR09KXiFE+9qQ4zPlKW5RAzkRjdvO56rWM4hzSKNSnW/GH/8FcqMVE2SnGHOP/ZmFwSw==",
         ["dist/index.js", "dist/*.LICENSE.txt", "LICENSE"], "jupyter-threejs"),
@@ -67,7 +67,7 @@ PACKAGES = {
         "2.7.9", "sha512-NOGEDTIM9+MrsqnjPEjVGNx4q0GQxqm61yQwSK+/5S59i26wId5IC5gNu9/bu8+CCVl5p9G2IHcAl/wJa+5+BQ==",
         # what config=TeX-AMS_CHTML-full,Safe loads: TeX in, CommonHTML out with its web fonts
         ["MathJax.js", "config/TeX-AMS_CHTML-full.js", "config/Safe.js", "extensions/*.js",
-         "extensions/TeX/*", "jax/input/TeX/*", "jax/output/CommonHTML/*", "jax/element/*",
+         "extensions/TeX/*", "jax/input/TeX/**", "jax/output/CommonHTML/**", "jax/element/**",
          "fonts/HTML-CSS/TeX/woff/*", "LICENSE"], "mathjax"),
 }
 
@@ -107,14 +107,21 @@ def fetch_tarball(name, version, integrity):
     return data
 
 
+def glob_pattern(glob):
+    """A compiled pattern for ``glob``: ``**`` matches across folders, ``*`` within one."""
+    parts = re.split(r"(\*\*|\*)", glob)
+    return re.compile("".join({"**": ".*", "*": "[^/]*"}.get(p, re.escape(p)) for p in parts))
+
+
 def install_assets(site):
     """Unpack the kept files of every package of :data:`PACKAGES` into ``site/assets/``."""
     for name, (version, integrity, keep, folder) in PACKAGES.items():
         target = site / ASSETS / folder
+        patterns = [glob_pattern(g) for g in keep]
         with tarfile.open(fileobj=io.BytesIO(fetch_tarball(name, version, integrity)), mode="r:gz") as tar:
             for member in tar.getmembers():
                 rel = member.name.split("/", 1)[1]   # members sit under "package/"
-                if member.isfile() and any(fnmatch.fnmatchcase(rel, g) for g in keep):
+                if member.isfile() and any(g.fullmatch(rel) for g in patterns):
                     dest = target / rel
                     dest.parent.mkdir(parents=True, exist_ok=True)
                     dest.write_bytes(tar.extractfile(member).read())
