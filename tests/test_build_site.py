@@ -137,3 +137,10 @@ def test_glob_patterns_of_kept_files():
     assert one.fullmatch("extensions/Safe.js") and not one.fullmatch("extensions/a11y/explorer.js")
     assert deep.fullmatch("jax/output/CommonHTML/fonts/TeX/fontdata.js")
     assert not deep.fullmatch("jax/output/SVG/jax.js")
+
+
+def test_build_never_replaces_a_folder_it_did_not_make(tmp_path):
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(SystemExit, match="holds no earlier build"):
+        build_site.build(tmp_path, names=["00_getting_started.ipynb"])
+    assert (tmp_path / "notes.txt").read_text() == "mine"

@@ -91,7 +91,8 @@ def fetch_tarball(name, version, integrity):
     """The package's tarball (bytes), from the cache or the registry, checked against ``integrity``."""
     algorithm, _, expected = integrity.partition("-")
     path = CACHE / f"{name.replace('/', '+')}-{version}.tgz"
-    if path.exists():
+    cached = path.exists()
+    if cached:
         data = path.read_bytes()
     else:
         url = f"{REGISTRY}/{name}/-/{name.rsplit('/', 1)[-1]}-{version}.tgz"
@@ -102,8 +103,9 @@ def fetch_tarball(name, version, integrity):
     if actual != expected:
         raise SystemExit(f"{name}@{version}: the download does not match its pinned {algorithm} "
                          f"hash ({actual} != {expected}); delete {path} and try again")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(data)
+    if not cached:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
     return data
 
 
@@ -338,8 +340,11 @@ def build(out=OUT, names=None, log=print):
     """Build the site into ``out``; returns a list of pages (file, title, live views,
     seconds, cell errors); the list is also written to ``out/pages.json``."""
     out = Path(out)
-    paths = [NOTEBOOKS / n for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
-    if out.exists():
+    paths = [NOTEBOOKS / Path(n).name for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+    if out.exists() and any(out.iterdir()):
+        if not (out / "pages.json").exists():
+            raise SystemExit(f"{out} is not empty and holds no earlier build of the site; "
+                             "choose an empty or new folder")
         shutil.rmtree(out)
     out.mkdir(parents=True)
     install_assets(out)
