@@ -230,7 +230,7 @@ def prepare_for_site(nb):
 def title_of(nb, fallback):
     for cell in nb.cells:
         if cell.cell_type == "markdown":
-            m = re.search(r"^#\s+(.+)$", cell.source, re.M)
+            m = re.search(r"^#\s+(.+)$", cell.source, re.MULTILINE)
             if m:
                 return m.group(1).strip()
     return fallback

@@ -174,7 +174,7 @@ def _check_canvases(page, expected, shots):
         canvas = canvases.nth(i)
         canvas.scroll_into_view_if_needed()
         canvas.hover()     # a view frozen to a picture comes back to life when the mouse enters
-        before = _wait_for(lambda: _shot_if(canvas, _not_blank), 30)
+        before = _wait_for(lambda canvas=canvas: _shot_if(canvas, _not_blank), 30)
         assert before, f"canvas {i} stays blank"
         (shots / f"canvas{i}.png").write_bytes(before)
         box = canvas.bounding_box()
@@ -183,7 +183,8 @@ def _check_canvases(page, expected, shots):
         page.mouse.down()
         page.mouse.move(x + 90, y + 25, steps=12)
         page.mouse.up()
-        after = _wait_for(lambda: _shot_if(canvas, lambda png: lablib.changed_fraction(before, png) > 0.01), 20)
+        after = _wait_for(lambda canvas=canvas, before=before: _shot_if(
+            canvas, lambda png: lablib.changed_fraction(before, png) > 0.01), 20)
         assert after, f"an orbit drag on canvas {i} does not change its picture"
         (shots / f"canvas{i}-dragged.png").write_bytes(after)
     return canvases.count()
@@ -191,7 +192,7 @@ def _check_canvases(page, expected, shots):
 
 @pytest.mark.parametrize("notebook", NOTEBOOKS)
 def test_page_offline(notebook, site, site_url, browser):
-    folder, pages = site
+    _, pages = site
     name = Path(notebook).stem + ".html"
     assert name in pages, f"{name} was not built"
     shots = SCREENSHOTS / Path(notebook).stem
@@ -233,10 +234,12 @@ def test_index_lists_pages_in_order(site, site_url, browser):
         view.page.goto(site_url + "index.html")
         links = view.page.eval_on_selector_all("ol a", "els => els.map(a => a.getAttribute('href'))")
         assert links == [Path(n).stem + ".html" for n in NOTEBOOKS]
-        for name in links:                     # relative links to files that exist
+        items = view.page.eval_on_selector_all("ol li", "els => els.map(e => e.innerText)")
+        for name, item in zip(links, items):   # relative links to files that exist
             assert "/" not in name and (folder / name).is_file()
-        nav = view.page.goto(site_url + links[0]) and view.page.eval_on_selector_all(
-            "nav.site-nav a", "els => els.map(a => a.getAttribute('href'))")
+            assert f"({pages[name]['views']} live 3D view" in item, item
+        view.page.goto(site_url + links[0])
+        nav = view.page.eval_on_selector_all("nav.site-nav a", "els => els.map(a => a.getAttribute('href'))")
         assert "index.html" in nav and (len(links) == 1 or links[1] in nav)
         assert not view.outside and not view.missing and not view.errors
     finally:
@@ -271,7 +274,7 @@ HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {
 
 def test_stills_show_without_webgl(site, site_url, browser):
     """In a browser without WebGL every 3D view's still picture is shown instead."""
-    folder, pages = site
+    _, pages = site
     name = next((f for f, p in pages.items() if p["views"]), None)
     assert name, "no page has a live 3D view"
     view = OfflinePage(browser, site_url)
