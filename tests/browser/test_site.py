@@ -242,6 +242,9 @@ def test_index_lists_pages_in_order(site, site_url, browser):
         nav = view.page.eval_on_selector_all("nav.site-nav a", "els => els.map(a => a.getAttribute('href'))")
         assert "index.html" in nav and (len(links) == 1 or links[1] in nav)
         assert not view.outside and not view.missing and not view.errors
+        # the guard itself: a request to the network is recorded and fails
+        reached = view.page.evaluate("() => fetch('https://example.org/').then(() => true, () => false)")
+        assert view.outside == ["https://example.org/"] and reached is False
     finally:
         view.close()
 
