@@ -5,6 +5,7 @@
     python3 workbook.py notebook   # the same in Jupyter Notebook 7 instead of JupyterLab
     python3 workbook.py test       # every test: unit, notebooks (nbval), browser
     python3 workbook.py assignment # the assignment version in build/assignment/
+    python3 workbook.py site       # the workbook as a static website in build/site/
     python3 workbook.py setup      # only create or update .venv
 
 Each creates the virtual environment ``.venv`` beside this file when it is
@@ -90,7 +91,7 @@ def front_end_command(app, args, root=False):
 
 
 def main(argv):
-    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment"):
+    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment", "site"):
         print(__doc__)
         return 2
     command, rest = argv[0], argv[1:]
@@ -101,6 +102,8 @@ def main(argv):
         return 0
     if command == "assignment":
         return subprocess.call([str(PY), str(ROOT / "tools" / "build_assignment.py"), *rest], cwd=ROOT, env=env)
+    if command == "site":
+        return subprocess.call([str(PY), str(ROOT / "tools" / "build_site.py"), *rest], cwd=ROOT, env=env)
     if command in ("lab", "notebook"):
         cmd = front_end_command(command, rest, root=hasattr(os, "geteuid") and os.geteuid() == 0)
         print("+", " ".join(cmd), flush=True)

@@ -1,0 +1,295 @@
+"""The workbook as a static website (tools/build_site.py), in headless Chromium
+with the network cut off.
+
+The site is built once per session into a temporary folder (every notebook
+executed; a few minutes), or taken from GEOMLIB_SITE_DIR when that names a
+folder built by ``python3 workbook.py site``. It is served by a static file
+server on a loopback port; every request that goes anywhere else is aborted
+and recorded, and the test asserts that there was none.
+
+On every page:
+1. no request left the machine, and no file of the site is missing;
+2. every 3D view's canvas shows a picture (not one flat colour), as many
+   canvases as the build counted live views;
+3. an orbit drag on every canvas changes its picture (no kernel involved);
+   (without WebGL, the still pictures are shown instead: a separate test);
+4. the formulas are typeset by the MathJax served from the site: MathJax
+   output is present, no TeX error, no ``$$`` left in the text;
+5. every control that needs a kernel is disabled, and a note says so;
+6. no console error and no uncaught exception;
+7. no cell raised an error while the notebook ran for the site.
+
+The index lists every notebook in reading order, and a page opened from
+``file://`` works the same way (canvases drawn, nothing fetched from outside).
+Screenshots: build/screenshots/site/.
+"""
+
+import functools
+import http.server
+import json
+import os
+import re
+import sys
+import threading
+import time
+from pathlib import Path
+
+import nbformat
+import pytest
+
+import lablib
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tools"))
+
+import build_site  # noqa: E402
+
+NOTEBOOKS = sorted(p.name for p in build_site.NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+SCREENSHOTS = ROOT / "build" / "screenshots" / "site"
+LOAD_TIMEOUT = 90          # seconds for a page's views and formulas to appear
+LOCAL_SCHEMES = ("file:", "data:", "blob:")
+
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture(scope="session")
+def site(browser, tmp_path_factory):
+    given = os.environ.get("GEOMLIB_SITE_DIR")
+    if given:
+        folder = Path(given)
+        assert (folder / "pages.json").exists(), f"GEOMLIB_SITE_DIR={given} holds no built site"
+    else:
+        folder = tmp_path_factory.mktemp("site")
+        build_site.build(folder)
+    pages = {p["file"]: p for p in json.loads((folder / "pages.json").read_text())}
+    return folder, pages
+
+
+@pytest.fixture(scope="session")
+def site_url(site):
+    handler = functools.partial(_QuietHandler, directory=str(site[0]))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.server_port}/"
+    server.shutdown()
+    server.server_close()
+
+
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+
+class OfflinePage:
+    """A page in a fresh browser context in which only ``base`` and local URLs load."""
+
+    def __init__(self, browser, base):
+        self.base = base
+        self.context = browser.new_context(viewport=lablib.VIEWPORT)
+        self.outside, self.missing, self.errors = [], [], []
+        self.context.route("**/*", self._route)
+        self.page = self.context.new_page()
+        self.page.on("request", self._request)
+        self.page.on("response", lambda r: self.missing.append(f"{r.status} {r.url}") if r.status >= 400 else None)
+        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.errors.append(f"uncaught: {e}"))
+
+    def _local(self, url):
+        return url.startswith(self.base) or url.startswith(LOCAL_SCHEMES)
+
+    def _request(self, request):
+        if not self._local(request.url):
+            self.outside.append(request.url)
+
+    def _route(self, route):
+        if self._local(route.request.url):
+            route.continue_()
+        else:
+            route.abort("internetdisconnected")
+
+    def close(self):
+        self.context.close()
+
+
+JS_MATH_DONE = """
+() => new Promise(done => {
+  if (!window.MathJax || !MathJax.Hub) { done(false); return; }
+  MathJax.Hub.Queue(() => done(true));
+})
+"""
+
+JS_MATH = """
+() => {
+  const formulas = document.querySelectorAll('script[type^="math/tex"]').length;
+  const text = Array.from(document.querySelectorAll('.jp-MarkdownOutput, .jp-RenderedMarkdown'))
+    .map(e => e.innerText).join('\\n');
+  return {
+    formulas: formulas,
+    typeset: document.querySelectorAll('.MathJax_CHTML').length,
+    errors: document.querySelectorAll('.mjx-merror, .MathJax_Error').length,
+    raw: (text.match(/\\$\\$/g) || []).length,
+  };
+}
+"""
+
+JS_CONTROLS = """
+() => {
+  const sliders = Array.from(document.querySelectorAll('.widget-slider, .widget-dropdown, .widget-toggle-buttons, .widget-checkbox, .widget-button'));
+  const enabled = sliders.filter(el => {
+    const inputs = el.querySelectorAll('input, select, button, .noUi-target, .slider');
+    return Array.from(inputs).some(i => !(i.disabled || i.hasAttribute('disabled')));
+  });
+  return {controls: sliders.length, enabled: enabled.length,
+          notes: document.querySelectorAll('.site-kernel-note').length};
+}
+"""
+
+
+def _wait_for(predicate, timeout, interval=0.5):
+    deadline = time.monotonic() + timeout
+    value = predicate()
+    while not value and time.monotonic() < deadline:
+        time.sleep(interval)
+        value = predicate()
+    return value
+
+
+def _not_blank(png):
+    distinct, covered = lablib.image_stats(png)
+    return distinct >= 20 and covered >= 0.01
+
+
+def _shot_if(canvas, accept):
+    png = lablib.stable_screenshot(canvas)
+    return png if accept(png) else None
+
+
+def _check_canvases(page, expected, shots):
+    """Every canvas drawn and turned by a drag; returns the number of canvases."""
+    canvases = page.locator("canvas")
+    assert _wait_for(lambda: canvases.count() >= expected, LOAD_TIMEOUT), \
+        f"{canvases.count()} canvases appeared; the build saved {expected} live views"
+    for i in range(canvases.count()):
+        canvas = canvases.nth(i)
+        canvas.scroll_into_view_if_needed()
+        canvas.hover()     # a view frozen to a picture comes back to life when the mouse enters
+        before = _wait_for(lambda canvas=canvas: _shot_if(canvas, _not_blank), 30)
+        assert before, f"canvas {i} stays blank"
+        (shots / f"canvas{i}.png").write_bytes(before)
+        box = canvas.bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.mouse.move(x, y)
+        page.mouse.down()
+        page.mouse.move(x + 90, y + 25, steps=12)
+        page.mouse.up()
+        after = _wait_for(lambda canvas=canvas, before=before: _shot_if(
+            canvas, lambda png: lablib.changed_fraction(before, png) > 0.01), 20)
+        assert after, f"an orbit drag on canvas {i} does not change its picture"
+        (shots / f"canvas{i}-dragged.png").write_bytes(after)
+    return canvases.count()
+
+
+@pytest.mark.parametrize("notebook", NOTEBOOKS)
+def test_page_offline(notebook, site, site_url, browser):
+    _, pages = site
+    name = Path(notebook).stem + ".html"
+    assert name in pages, f"{name} was not built"
+    shots = SCREENSHOTS / Path(notebook).stem
+    shots.mkdir(parents=True, exist_ok=True)
+    view = OfflinePage(browser, site_url)
+    try:
+        page = view.page
+        page.goto(site_url + name, wait_until="load")
+        assert page.evaluate(JS_MATH_DONE), "MathJax did not load"
+        math = page.evaluate(JS_MATH)
+        markdown = "\n".join(c.source for c in nbformat.read(build_site.NOTEBOOKS / notebook, 4).cells
+                             if c.cell_type == "markdown")
+        if re.search(r"\$[^$\s][^$]*\$", markdown):
+            assert math["formulas"] > 0, "the notebook has formulas but MathJax found none"
+        assert math["typeset"] >= math["formulas"], \
+            f"MathJax typeset {math['typeset']} of {math['formulas']} formulas"
+        assert math["errors"] == 0, f"{math['errors']} formulas show a TeX error"
+        assert math["raw"] == 0, f"{math['raw']} '$$' left untypeset in the text"
+
+        _check_canvases(page, pages[name]["views"], shots)
+
+        controls = page.evaluate(JS_CONTROLS)
+        assert controls["enabled"] == 0, f"{controls['enabled']} controls look usable without a kernel"
+        if controls["controls"]:
+            assert controls["notes"] > 0, "controls are shown without the note that they need JupyterLab"
+        page.screenshot(path=str(shots / "page.png"))
+        assert not view.outside, f"requests to the network: {view.outside}"
+        assert not view.missing, f"files missing from the site: {view.missing}"
+        assert not view.errors, "console errors:\n" + "\n".join(view.errors)
+    finally:
+        view.close()
+    assert not pages[name]["errors"], "cells raised errors while the site was built:\n" + "\n".join(pages[name]["errors"])
+
+
+def test_index_lists_pages_in_order(site, site_url, browser):
+    folder, pages = site
+    view = OfflinePage(browser, site_url)
+    try:
+        view.page.goto(site_url + "index.html")
+        links = view.page.eval_on_selector_all("ol a", "els => els.map(a => a.getAttribute('href'))")
+        assert links == [Path(n).stem + ".html" for n in NOTEBOOKS]
+        items = view.page.eval_on_selector_all("ol li", "els => els.map(e => e.innerText)")
+        for name, item in zip(links, items):   # relative links to files that exist
+            assert "/" not in name and (folder / name).is_file()
+            assert f"({pages[name]['views']} live 3D view" in item, item
+        view.page.goto(site_url + links[0])
+        nav = view.page.eval_on_selector_all("nav.site-nav a", "els => els.map(a => a.getAttribute('href'))")
+        assert "index.html" in nav and (len(links) == 1 or links[1] in nav)
+        assert not view.outside and not view.missing and not view.errors
+        # the guard itself: a request to the network is recorded and fails
+        reached = view.page.evaluate("() => fetch('https://example.org/').then(() => true, () => false)")
+        assert view.outside == ["https://example.org/"] and reached is False
+    finally:
+        view.close()
+
+
+def test_page_from_file_url(site, browser):
+    """The folder works without any server: the first page with views, opened from file://."""
+    folder, pages = site
+    name = next((f for f, p in pages.items() if p["views"]), None)
+    assert name, "no page has a live 3D view"
+    view = OfflinePage(browser, (folder / "index.html").resolve().as_uri().rsplit("/", 1)[0] + "/")
+    try:
+        view.page.goto((folder / name).resolve().as_uri())
+        assert view.page.evaluate(JS_MATH_DONE), "MathJax did not load from file://"
+        shots = SCREENSHOTS / "file-url"
+        shots.mkdir(parents=True, exist_ok=True)
+        _check_canvases(view.page, pages[name]["views"], shots)
+        assert not view.outside, f"requests to the network: {view.outside}"
+        assert not view.errors, "console errors:\n" + "\n".join(view.errors)
+    finally:
+        view.close()
+
+
+NO_WEBGL = """
+const getContext = HTMLCanvasElement.prototype.getContext;
+HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {
+  return /webgl/.test(kind) ? null : getContext.call(this, kind, ...rest);
+};
+"""
+
+
+def test_stills_show_without_webgl(site, site_url, browser):
+    """In a browser without WebGL every 3D view's still picture is shown instead."""
+    _, pages = site
+    name = next((f for f, p in pages.items() if p["views"]), None)
+    assert name, "no page has a live 3D view"
+    view = OfflinePage(browser, site_url)
+    try:
+        view.context.add_init_script(NO_WEBGL)
+        view.page.goto(site_url + name, wait_until="load")
+        stills = view.page.locator("img.site-still")
+        assert stills.count() > 0, "the page holds no still pictures of its views"
+        assert _wait_for(lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30), \
+            f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
+        for i in range(stills.count()):
+            assert _not_blank(lablib.stable_screenshot(stills.nth(i))), f"still {i} is blank"
+        assert not view.outside, f"requests to the network: {view.outside}"
+    finally:
+        view.close()

@@ -1,0 +1,146 @@
+"""tools/build_site.py without a browser: how an executed notebook is made fit
+for a static page, and the check of the pinned downloads."""
+
+import base64
+import hashlib
+import re
+import sys
+from pathlib import Path
+
+import nbformat
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
+
+import build_site  # noqa: E402
+
+
+def _model(name, module="@jupyter-widgets/controls", **state):
+    return {"model_name": name, "model_module": module, "model_module_version": "2.0.0", "state": state}
+
+
+def _view(model_id, png=True):
+    data = {build_site.WIDGET_VIEW: {"version_major": 2, "version_minor": 0, "model_id": model_id},
+            "text/plain": "MeshView"}
+    if png:
+        data["image/png"] = "iVBORw0KGgo="
+    return nbformat.v4.new_output("display_data", data=data)
+
+
+def _notebook():
+    """A slider and a 3D view in one box, a view alone, and a view whose state was not saved."""
+    state = {
+        "box": _model("VBoxModel", children=["IPY_MODEL_slider", "IPY_MODEL_r1"]),
+        "slider": _model("FloatSliderModel", value=0.0, disabled=False),
+        "r1": _model("RendererModel", module="jupyter-threejs", scene="IPY_MODEL_scene"),
+        "scene": _model("SceneModel", module="jupyter-threejs", children=[]),
+        "r2": _model("RendererModel", module="jupyter-threejs", scene="IPY_MODEL_scene"),
+        "label": _model("HTMLModel", value="<b>H</b>"),
+    }
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["widgets"] = {build_site.WIDGET_STATE: {"version_major": 2, "version_minor": 0, "state": state}}
+    cells = [nbformat.v4.new_code_cell("box"), nbformat.v4.new_code_cell("view"),
+             nbformat.v4.new_code_cell("lost"), nbformat.v4.new_markdown_cell("# 03 · A title\n\ntext")]
+    cells[0].outputs = [_view("box")]
+    cells[1].outputs = [_view("r2"), _view("label", png=False)]
+    cells[2].outputs = [_view("gone")]
+    nb.cells = cells
+    return nb, nb.metadata["widgets"][build_site.WIDGET_STATE]["state"]
+
+
+def test_controls_are_disabled_and_noted():
+    nb, state = _notebook()
+    assert build_site.prepare_for_site(nb) == 2
+    assert state["slider"]["state"]["disabled"] is True
+    first = nb.cells[0].outputs       # view, its hidden still, the note
+    assert len(first) == 3 and build_site.WIDGET_VIEW in first[0]["data"]
+    assert 'class="site-still" hidden' in first[1]["data"]["text/html"]
+    assert "base64,iVBORw0KGgo=" in first[1]["data"]["text/html"]
+    assert build_site.KERNEL_NOTE in first[2]["data"]["text/html"]
+    # no control in the second cell: no note; the label has no still
+    assert len(nb.cells[1].outputs) == 3
+    assert all("site-kernel-note" not in str(o) for o in nb.cells[1].outputs)
+
+
+def test_a_view_without_saved_state_keeps_its_still():
+    nb, _ = _notebook()
+    build_site.prepare_for_site(nb)
+    (lost,) = nb.cells[2].outputs
+    assert build_site.WIDGET_VIEW not in lost["data"]
+    assert lost["data"]["image/png"] == "iVBORw0KGgo="
+
+
+def test_title_is_the_first_heading():
+    nb, _ = _notebook()
+    assert build_site.title_of(nb, "fallback") == "03 · A title"
+    assert build_site.title_of(nbformat.v4.new_notebook(), "fallback") == "fallback"
+
+
+def test_navigation_links_neighbours():
+    pages = [{"file": f"{i:02d}.html", "title": f"page {i}"} for i in range(3)]
+    first, middle, last = (build_site.nav_html(pages, i) for i in range(3))
+    assert 'href="01.html"' in first and 'href="00.html"' not in first
+    assert 'href="00.html"' in middle and 'href="02.html"' in middle
+    assert 'href="01.html"' in last and 'href="02.html"' not in last
+    assert all('href="index.html"' in nav for nav in (first, middle, last))
+
+
+def test_download_must_match_its_pinned_hash(tmp_path, monkeypatch):
+    monkeypatch.setattr(build_site, "CACHE", tmp_path)
+    data = b"not the package"
+    (tmp_path / "pkg-1.0.0.tgz").write_bytes(data)
+    good = "sha512-" + base64.b64encode(hashlib.sha512(data).digest()).decode()
+    assert build_site.fetch_tarball("pkg", "1.0.0", good) == data
+    bad = "sha512-" + base64.b64encode(hashlib.sha512(b"other").digest()).decode()
+    with pytest.raises(SystemExit, match="does not match its pinned sha512"):
+        build_site.fetch_tarball("pkg", "1.0.0", bad)
+
+
+def test_every_package_is_pinned_exactly():
+    for name, (version, integrity, keep, folder) in build_site.PACKAGES.items():
+        assert version.count(".") == 2 and version.replace(".", "").isdigit(), name
+        assert integrity.startswith("sha512-") and len(base64.b64decode(integrity[7:])) == 64, name
+        assert keep and folder
+
+
+def test_cell_errors_are_listed():
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_markdown_cell("text"), nbformat.v4.new_code_cell("1 / 0")]
+    nb.cells[1].outputs = [nbformat.v4.new_output("error", ename="ZeroDivisionError",
+                                                  evalue="division by zero", traceback=[])]
+    assert build_site.cell_errors(nb) == ["cell 1: ZeroDivisionError: division by zero"]
+    nb.cells[1].outputs = []
+    assert build_site.cell_errors(nb) == []
+
+
+def test_page_loads_nothing_from_a_cdn_and_folds_hidden_code():
+    nb, _ = _notebook()
+    nb.cells.append(nbformat.v4.new_markdown_cell("A formula $\\Delta = M^{-1} C$."))
+    hidden = nbformat.v4.new_code_cell("explain('...')")
+    hidden.metadata["jupyter"] = {"source_hidden": True}
+    nb.cells.append(hidden)
+    build_site.prepare_for_site(nb)
+    nav = build_site.nav_html([{"file": "03.html", "title": "03"}], 0)
+    body, _ = build_site.exporter().from_notebook_node(nb, resources={"site_nav": nav})
+    # no script, style sheet or font from elsewhere (URLs in CSS comments are fine)
+    remote = re.findall(r"""(?:src=|href=|url\(|import\()\s*["']?(?:https?:)?//[^"')\s]+""", body)
+    assert not remote, remote[:3]
+    assert "unpkg.com" not in body and "cdnjs" not in body
+    assert f'src="{build_site.REQUIRE_JS}"' in body and build_site.WIDGET_RENDERER in body
+    assert build_site.MATHJAX.split("?")[0] in body
+    assert body.count('<details class="site-hidden-input">') == 1
+    assert body.count('class="site-nav"') == 1 and body.count('class="site-nav bottom"') == 1
+
+
+def test_glob_patterns_of_kept_files():
+    one, deep = build_site.glob_pattern("extensions/*.js"), build_site.glob_pattern("jax/output/CommonHTML/**")
+    assert one.fullmatch("extensions/Safe.js") and not one.fullmatch("extensions/a11y/explorer.js")
+    assert deep.fullmatch("jax/output/CommonHTML/fonts/TeX/fontdata.js")
+    assert not deep.fullmatch("jax/output/SVG/jax.js")
+
+
+def test_build_never_replaces_a_folder_it_did_not_make(tmp_path):
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(SystemExit, match="holds no earlier build"):
+        build_site.build(tmp_path, names=["00_getting_started.ipynb"])
+    assert (tmp_path / "notes.txt").read_text() == "mine"

@@ -1,0 +1,403 @@
+"""Build the workbook as a static website in build/site/.
+
+    python3 workbook.py site                 # every notebook in notebooks/
+    python tools/build_site.py --out DIR 00_getting_started.ipynb ...   # some of them
+
+Every notebook is executed with its default parameters (nbclient, widget state
+stored) and rendered as an HTML page (nbconvert's ``lab`` template); an index
+page lists them in reading order and each page links to the previous and next.
+The 3D views stay live in the page: the saved widget state is rendered by the
+Jupyter widgets HTML manager and pythreejs's browser code, both served from
+``assets/`` in the site folder together with require.js and MathJax, so a page
+needs no kernel and no network. Links are relative: the folder works from any
+static web server and from ``file://``.
+
+Controls that need a kernel (sliders, dropdowns, ...) are shown disabled at
+their default value, with one line saying that they recompute in JupyterLab.
+A view whose widget state was not saved keeps its still picture.
+
+The JavaScript comes from the npm registry, pinned by version and by the
+registry's sha512 integrity hash (:data:`PACKAGES`); downloads are kept in
+build/npm-cache/ so later builds need no network.
+"""
+
+import argparse
+import base64
+import hashlib
+import html
+import io
+import json
+import re
+import shutil
+import sys
+import tarfile
+import time
+import urllib.request
+from pathlib import Path
+
+import nbformat
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+OUT = ROOT / "build" / "site"
+CACHE = ROOT / "build" / "npm-cache"
+ASSETS = "assets"
+REGISTRY = "https://registry.npmjs.org"
+
+#: npm package -> (version, integrity, files kept, folder in assets/). The files kept are
+#: globs inside the package: ``*`` stays within one folder, ``**`` crosses folders.
+#: html-manager 1.0.x is the renderer of ipywidgets 8; jupyter-threejs 2.4.1 is the
+#: browser side of pythreejs 2.4.2 (its EXTENSION_SPEC_VERSION ^2.4.1),
+#: jupyter-datawidgets 5.5.2 that of ipydatawidgets 4.3.5.
+PACKAGES = {
+    "requirejs": (
+        "2.3.7", "sha512-DouTG8T1WanGok6Qjg2SXuCMzszOo0eHeH9hDZ5Y4x8Je+9JB38HdTLT4/VA8OaUhBa0JPVHJ0pyBkM1z+pDsw==",
+        ["require.js", "LICENSE"], "requirejs"),
+    "@jupyter-widgets/html-manager": (
+        "1.0.15", "sha512-5thBIV6ymNgmPVOHvzx+gGy8ZSKmSazhtGw4/c4xJDVzRhG9PTeQsRjF3FUTopvFi//SABeNz1yp47bCrJ3CQA==",
+        # its style sheet lists each icon font in several formats; browsers take the woff2
+        ["dist/embed-amd.js", "dist/*.woff2", "dist/*.woff", "dist/*.LICENSE.txt", "LICENSE"], "html-manager"),
+    "jupyter-threejs": (
+        "2.4.1", "sha512-AFoYllRmV5Hy1Hbyq8NR09KXiFE+9qQ4zPlKW5RAzkRjdvO56rWM4hzSKNSnW/GH/8FcqMVE2SnGHOP/ZmFwSw==",
+        ["dist/index.js", "dist/*.LICENSE.txt", "LICENSE"], "jupyter-threejs"),
+    "jupyter-datawidgets": (
+        "5.5.2", "sha512-gRNoe9I21veWAr78+4bzjUuhwuI5VmdSphTepUUB5AHNN1etxr9qpql0Gug41CO085HuzqxLUXF4zCMIoXUZpQ==",
+        ["dist/index.js", "LICENSE*"], "jupyter-datawidgets"),
+    "mathjax": (
+        "2.7.9", "sha512-NOGEDTIM9+MrsqnjPEjVGNx4q0GQxqm61yQwSK+/5S59i26wId5IC5gNu9/bu8+CCVl5p9G2IHcAl/wJa+5+BQ==",
+        # what config=TeX-AMS_CHTML-full,Safe loads: TeX in, CommonHTML out with its web fonts
+        ["MathJax.js", "config/TeX-AMS_CHTML-full.js", "config/Safe.js", "extensions/*.js",
+         "extensions/TeX/*", "jax/input/TeX/**", "jax/output/CommonHTML/**", "jax/element/**",
+         "fonts/HTML-CSS/TeX/woff/*", "LICENSE"], "mathjax"),
+}
+
+REQUIRE_JS = f"{ASSETS}/requirejs/require.js"
+WIDGET_RENDERER = f"{ASSETS}/html-manager/dist/embed-amd.js"
+MATHJAX = f"{ASSETS}/mathjax/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
+AMD_PATHS = {"jupyter-threejs": f"{ASSETS}/jupyter-threejs/dist/index",
+             "jupyter-datawidgets": f"{ASSETS}/jupyter-datawidgets/dist/index"}
+
+WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
+KERNEL_NOTE = ("In JupyterLab this control recomputes the result; "
+               "on this page it stays at its default value.")
+
+# ---------------------------------------------------------------------------
+# the pinned JavaScript
+# ---------------------------------------------------------------------------
+
+
+def fetch_tarball(name, version, integrity):
+    """The package's tarball (bytes), from the cache or the registry, checked against ``integrity``."""
+    algorithm, _, expected = integrity.partition("-")
+    path = CACHE / f"{name.replace('/', '+')}-{version}.tgz"
+    cached = path.exists()
+    if cached:
+        data = path.read_bytes()
+    else:
+        url = f"{REGISTRY}/{name}/-/{name.rsplit('/', 1)[-1]}-{version}.tgz"
+        print(f"downloading {url}", flush=True)
+        with urllib.request.urlopen(url, timeout=120) as response:
+            data = response.read()
+    actual = base64.b64encode(hashlib.new(algorithm, data).digest()).decode()
+    if actual != expected:
+        raise SystemExit(f"{name}@{version}: the download does not match its pinned {algorithm} "
+                         f"hash ({actual} != {expected}); delete {path} and try again")
+    if not cached:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
+    return data
+
+
+def glob_pattern(glob):
+    """A compiled pattern for ``glob``: ``**`` matches across folders, ``*`` within one."""
+    parts = re.split(r"(\*\*|\*)", glob)
+    return re.compile("".join({"**": ".*", "*": "[^/]*"}.get(p, re.escape(p)) for p in parts))
+
+
+def install_assets(site):
+    """Unpack the kept files of every package of :data:`PACKAGES` into ``site/assets/``."""
+    for name, (version, integrity, keep, folder) in PACKAGES.items():
+        target = site / ASSETS / folder
+        patterns = [glob_pattern(g) for g in keep]
+        with tarfile.open(fileobj=io.BytesIO(fetch_tarball(name, version, integrity)), mode="r:gz") as tar:
+            for member in tar.getmembers():
+                rel = member.name.split("/", 1)[1]   # members sit under "package/"
+                if member.isfile() and any(g.fullmatch(rel) for g in patterns):
+                    dest = target / rel
+                    dest.parent.mkdir(parents=True, exist_ok=True)
+                    dest.write_bytes(tar.extractfile(member).read())
+        (target / "VERSION").write_text(f"{name}@{version} ({integrity})\n")
+
+
+# ---------------------------------------------------------------------------
+# executing and preparing a notebook
+# ---------------------------------------------------------------------------
+
+
+def execute(path, timeout=1200):
+    """Run the notebook at ``path`` top to bottom in its folder; the widget state is stored.
+
+    A cell that raises does not stop the run (the page shows the error, like
+    JupyterLab would); :func:`cell_errors` lists them.
+    """
+    from nbclient import NotebookClient
+
+    nb = nbformat.read(path, as_version=4)
+    client = NotebookClient(nb, timeout=timeout, kernel_name="python3", store_widget_state=True,
+                            allow_errors=True, resources={"metadata": {"path": str(path.parent)}})
+    client.execute()
+    return nb
+
+
+def cell_errors(nb):
+    """``"cell N: Name: message"`` for every error output of an executed notebook (N from 0)."""
+    return [f"cell {i}: {out.get('ename', '?')}: {out.get('evalue', '')}".strip()
+            for i, cell in enumerate(nb.cells) if cell.cell_type == "code"
+            for out in cell.get("outputs", []) if out.get("output_type") == "error"]
+
+
+def _references(value):
+    """Model ids referred to (``"IPY_MODEL_<id>"``) anywhere inside a widget's state."""
+    if isinstance(value, str):
+        return [value[10:]] if value.startswith("IPY_MODEL_") else []
+    if isinstance(value, dict):
+        value = list(value.values())
+    if isinstance(value, list):
+        return [ref for item in value for ref in _references(item)]
+    return []
+
+
+def _reachable(model_id, state):
+    seen, todo = set(), [model_id]
+    while todo:
+        mid = todo.pop()
+        if mid in seen or mid not in state:
+            continue
+        seen.add(mid)
+        todo.extend(_references(state[mid].get("state", {})))
+    return seen
+
+
+def _is_control(model):
+    """An ipywidgets control the reader moves (it has a ``disabled`` trait): needs a kernel."""
+    return model.get("model_module") == "@jupyter-widgets/controls" and "disabled" in model.get("state", {})
+
+
+def _html_output(text):
+    return nbformat.v4.new_output("display_data", data={"text/html": text})
+
+
+def prepare_for_site(nb):
+    """Make an executed notebook fit for a static page (in place); returns the live view count.
+
+    - every control is saved disabled (it cannot recompute without a kernel), and an
+      output that holds one gets a one-line note after it;
+    - an output whose widget was not saved loses its widget part, so its still
+      picture (image/png) or text is shown instead;
+    - a live 3D view keeps its still picture, hidden, after it: the page shows it
+      when the browser has no WebGL or the view did not appear (script in TEMPLATE).
+    """
+    state = nb.metadata.get("widgets", {}).get(WIDGET_STATE, {}).get("state", {})
+    for model in state.values():
+        if _is_control(model):
+            model["state"]["disabled"] = True
+    live = 0
+    for cell in nb.cells:
+        if cell.cell_type != "code":
+            continue
+        outputs = []
+        for output in cell.get("outputs", []):
+            outputs.append(output)
+            view = output.get("data", {}).get(WIDGET_VIEW)
+            if view is None:
+                continue
+            models = _reachable(view["model_id"], state)
+            if not models:
+                del output["data"][WIDGET_VIEW]
+                continue
+            renderers = sum(state[m].get("model_name") == "RendererModel" for m in models)
+            live += renderers
+            if renderers and "image/png" in output["data"]:
+                outputs.append(_html_output(f'<img class="site-still" hidden alt="still picture of the 3D view" '
+                                            f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'))
+            if any(_is_control(state[m]) for m in models):
+                outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(KERNEL_NOTE)}</p>'))
+        cell.outputs = outputs
+    return live
+
+
+def title_of(nb, fallback):
+    for cell in nb.cells:
+        if cell.cell_type == "markdown":
+            m = re.search(r"^#\s+(.+)$", cell.source, re.MULTILINE)
+            if m:
+                return m.group(1).strip()
+    return fallback
+
+
+# ---------------------------------------------------------------------------
+# pages
+# ---------------------------------------------------------------------------
+
+TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
+{%- block html_head_js_requirejs -%}
+{{ super() }}
+<script>require.config({paths: %(paths)s});</script>
+<style>
+nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
+  font-family: var(--jp-ui-font-family); font-size: 14px; border-bottom: 1px solid #ddd; }
+nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
+p.site-kernel-note { font-style: italic; color: #555; margin: 0.2em 0; }
+details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 13px;
+  font-family: var(--jp-ui-font-family); margin: 0.3em 0 0.3em 6em; }
+</style>
+{%- endblock html_head_js_requirejs -%}
+{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+{% block input_group -%}
+{%- if cell.metadata.get("jupyter", {}).get("source_hidden") -%}
+<details class="site-hidden-input"><summary>Show the code of this cell</summary>
+{{ super() }}
+</details>
+{%- else -%}
+{{ super() }}
+{%- endif -%}
+{% endblock input_group %}
+{%- block body_header -%}
+{{ super() }}
+{{ resources.site_nav }}
+{%- endblock body_header -%}
+{% block body_footer %}
+{{ resources.site_nav.replace('class="site-nav"', 'class="site-nav bottom"') }}
+<script>
+// the still picture of a 3D view replaces nothing; it appears below the view when
+// the browser has no WebGL, or when the view has drawn no canvas 30 s after loading
+(function () {
+  function reveal(all) {
+    document.querySelectorAll("img.site-still").forEach(function (img) {
+      var child = img.closest(".jp-OutputArea-child");
+      var view = child && child.previousElementSibling;
+      if (all || !(view && view.querySelector("canvas"))) img.hidden = false;
+    });
+  }
+  var probe = document.createElement("canvas").getContext("webgl");
+  if (probe) {
+    var lose = probe.getExtension("WEBGL_lose_context");
+    if (lose) lose.loseContext();
+    window.addEventListener("load", function () { setTimeout(reveal, 30000, false); });
+  } else {
+    document.addEventListener("DOMContentLoaded", function () { reveal(true); });
+  }
+})();
+</script>
+{{ super() }}
+{% endblock body_footer %}
+"""
+
+
+def exporter():
+    from jinja2 import DictLoader
+    from nbconvert import HTMLExporter
+
+    template = TEMPLATE.replace("%(paths)s", json.dumps(AMD_PATHS))
+    return HTMLExporter(extra_loaders=[DictLoader({"site.html.j2": template})], template_file="site.html.j2",
+                        require_js_url=REQUIRE_JS, widget_renderer_url=WIDGET_RENDERER,
+                        mathjax_url=MATHJAX)
+
+
+def nav_html(pages, i):
+    def link(j, label):
+        if 0 <= j < len(pages):
+            return f'<a href="{pages[j]["file"]}">{label} {html.escape(pages[j]["title"])}</a>'
+        return "<span></span>"
+    return (f'<nav class="site-nav">{link(i - 1, "&larr;")}<a href="index.html">Contents</a>'
+            f'{link(i + 1, "&rarr;")}</nav>')
+
+
+INDEX = """<!DOCTYPE html>
+<html lang="en">
+<head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1.0">
+<title>{title}</title>
+<style>
+body {{ font-family: system-ui, sans-serif; max-width: 50em; margin: 2em auto; padding: 0 1em; line-height: 1.5; }}
+li {{ margin: 0.4em 0; }}
+.views {{ color: #666; font-size: 0.9em; }}
+</style></head>
+<body>
+<h1>{title}</h1>
+<p>Every notebook of the workbook, run with its default parameters. The 3D views
+turn in the page: drag to orbit, scroll to zoom, right-drag to pan. Sliders and
+other controls recompute only in JupyterLab; here they show their default value.</p>
+<ol>
+{items}
+</ol>
+</body>
+</html>
+"""
+
+
+def build(out=OUT, names=None, log=print):
+    """Build the site into ``out``; returns a list of pages (file, title, live views,
+    seconds, cell errors); the list is also written to ``out/pages.json``."""
+    out = Path(out)
+    paths = [NOTEBOOKS / Path(n).name for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+    if out.exists() and any(out.iterdir()):
+        if not (out / "pages.json").exists():
+            raise SystemExit(f"{out} is not empty and holds no earlier build of the site; "
+                             "choose an empty or new folder")
+        shutil.rmtree(out)
+    out.mkdir(parents=True)
+    install_assets(out)
+    pages = []
+    executed = []
+    for path in paths:
+        start = time.perf_counter()
+        log(f"executing {path.name} ...")
+        nb = execute(path)
+        live = prepare_for_site(nb)
+        pages.append({"file": path.stem + ".html", "title": title_of(nb, path.stem), "views": live,
+                      "seconds": round(time.perf_counter() - start, 1), "errors": cell_errors(nb)})
+        executed.append(nb)
+        log(f"  {pages[-1]['seconds']} s, {live} live 3D views")
+        for error in pages[-1]["errors"]:
+            log(f"  ERROR in {error}")
+    page_exporter = exporter()
+    for i, (page, nb) in enumerate(zip(pages, executed)):
+        body, _ = page_exporter.from_notebook_node(nb, resources={"site_nav": nav_html(pages, i),
+                                                             "metadata": {"name": page["title"]}})
+        (out / page["file"]).write_text(body, encoding="utf-8")
+    items = "\n".join(f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
+                      f'<span class="views">({p["views"]} live 3D view{"" if p["views"] == 1 else "s"})</span></li>'
+                      for p in pages)
+    (out / "index.html").write_text(INDEX.format(title="Discrete curvature and Laplacian mesh processing",
+                                                 items=items), encoding="utf-8")
+    (out / "pages.json").write_text(json.dumps(pages, indent=1))
+    return pages
+
+
+def folder_size(path):
+    return sum(f.stat().st_size for f in Path(path).rglob("*") if f.is_file())
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("notebooks", nargs="*", help="file names in notebooks/ (default: all)")
+    parser.add_argument("--out", default=str(OUT), help="output folder (default: build/site)")
+    args = parser.parse_args(argv)
+    start = time.perf_counter()
+    pages = build(args.out, args.notebooks or None)
+    size = folder_size(args.out)
+    print(f"\nbuilt {args.out} in {time.perf_counter() - start:.0f} s, {size / 1e6:.1f} MB:")
+    for p in pages:
+        errors = f", {len(p['errors'])} cell errors" if p["errors"] else ""
+        print(f"  {p['file']:45s} {p['views']:2d} live 3D views{errors}")
+    print(f"open {Path(args.out) / 'index.html'} in a browser, or copy the folder to any static web host")
+    failed = [p["file"] for p in pages if p["errors"]]
+    if failed:
+        print(f"\ncells raised errors in {', '.join(failed)} (the pages show them); see above")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
