@@ -44,8 +44,9 @@ def test_03_two_components_sphere_axes_and_high_ends(tmp_path):
 
 
 def test_03_cad_part_long_ellipsoid(tmp_path):
-    run = ran(NB03, MESH=str(cad_part(tmp_path)), LEVELS=[1, 2, 3], AXES=(3.0, 1.0, 0.2), JITTER=0.3)
-    assert not run.error
+    run = ran(NB03, MESH=str(cad_part(tmp_path)), LEVELS=[1, 2], AXES=(3.0, 1.0, 0.2), JITTER=0.3, VIEW_LEVEL=2,
+              SADDLE_N=16)
+    said(run, "over levels [1, 2]")
 
 
 def test_04_scan_with_unused_vertices(tmp_path):
