@@ -113,11 +113,14 @@ def explain(template, **values):
     _display({"text/markdown": text, "text/plain": text})
 
 
-def note(text, **values):
-    """Display a visible note about the reader's inputs (a quoted Markdown paragraph)."""
-    text = _fill(text, values)
+def _show_note(text):
     quoted = "\n".join("> " + line for line in f"**Note.** {text}".splitlines())
     _display({"text/markdown": quoted, "text/plain": f"{NOTE_PREFIX} {text}"})
+
+
+def note(text, **values):
+    """Display a visible note about the reader's inputs (a quoted Markdown paragraph)."""
+    _show_note(_fill(text, values))
 
 
 def claim(holds, statement, why="", **values):
@@ -143,5 +146,6 @@ def claim(holds, statement, why="", **values):
     said, differs = _fill(statement, values), _fill(why, values) if why else ""
     if strict_claims():
         raise ClaimFailed(f"the text says {said}, but it does not hold" + (f": {differs}" if differs else ""))
-    note(f"The text says {said}. With these inputs it does not hold" + (f": {differs}" if differs else "."))
+    # the text is filled already: braces in the values (a dict, LaTeX) must not be read as placeholders
+    _show_note(f"The text says {said}. With these inputs it does not hold" + (f": {differs}" if differs else "."))
     return False

@@ -125,3 +125,9 @@ def test_use_falls_back_to_the_reference(capsys, monkeypatch):
     assert "has not passed its check yet" in capsys.readouterr().out
     good = lambda x: 2 * x  # noqa: E731
     assert use(good, _check_double, reference) is good
+
+
+def test_braces_in_the_values_are_not_placeholders(shown, monkeypatch):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+    claim(False, "the set is {s}", "$\\frac{{1}}{{2}}$ differs", s={1, 2})
+    assert shown[0]["text/plain"] == f"{NOTE_PREFIX} The text says the set is {{1, 2}}. With these inputs it does not hold: $\\frac{{1}}{{2}}$ differs"
