@@ -1,6 +1,5 @@
 """Tests for geomlib.topology: closed-form counts, orientation laws, course meshes."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
