@@ -167,14 +167,24 @@ def _obj_statements(data, starts, ends, where):
 
 
 def _select(data, starts, ends, idx, keyword):
-    """The lines ``idx`` without their keyword, concatenated (each keeps its newline)."""
+    """The lines ``idx`` (each with its newline) concatenated, their keyword blanked.
+
+    The keyword's letter occurs nowhere else in a valid v or f line, so a
+    byte replacement removes it.
+    """
     if len(idx) == 0:
         return b""
-    arr = np.frombuffer(data, np.uint8)
-    keep = np.zeros(len(arr) + 1, np.int8)
-    keep[starts[idx] + len(keyword)] = 1  # from after the keyword ...
-    keep[ends[idx] + 1] -= 1              # ... to the newline included
-    return arr[np.cumsum(keep[:-1], dtype=np.int8).view(bool)].tobytes()
+    breaks = np.flatnonzero(np.diff(idx) != 1)
+    if len(breaks) < 64:  # a few runs of consecutive lines (all v, then all f): plain slices
+        first, last = np.r_[idx[0], idx[breaks + 1]], np.r_[idx[breaks], idx[-1]]
+        buf = b"".join(data[a:b + 1] for a, b in zip(starts[first].tolist(), ends[last].tolist()))
+    else:  # interleaved lines (v and vn alternating): a mask of the bytes to keep
+        arr = np.frombuffer(data, np.uint8)
+        keep = np.zeros(len(arr) + 1, np.int8)
+        keep[starts[idx]] = 1
+        keep[ends[idx] + 1] -= 1
+        buf = arr[np.cumsum(keep[:-1], dtype=np.int8).view(bool)].tobytes()
+    return buf.replace(keyword, b" ")
 
 
 def _tokens_per_line(buf):

@@ -34,6 +34,8 @@ __all__ = [
     "vertex_face_adjacency",
     "edge_face_counts",
     "boundary_edge_counts",
+    "unreferenced_vertices",
+    "non_manifold_edges",
     "Topology",
     "loops_from_edges",
 ]
@@ -573,3 +575,15 @@ def boundary_edge_counts(F, n=None):
     """
     E, count = edge_face_counts(F, n)
     return np.bincount(E[count == 1].ravel(), minlength=_nverts(np.asarray(F), n)).astype(np.int64)
+
+
+def unreferenced_vertices(F, n):
+    """Indices (k,) int64 of the vertices that no face uses (e.g. left over in a scan's file), sorted."""
+    F = as_faces(F, n)
+    return np.flatnonzero(np.bincount(F.ravel(), minlength=int(n)) == 0)
+
+
+def non_manifold_edges(F, n=None):
+    """Edges (k, 2) int64 that belong to three or more faces (smaller index first, lexicographic)."""
+    E, count = edge_face_counts(F, n)
+    return E[count > 2]

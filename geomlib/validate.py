@@ -196,7 +196,12 @@ def zero_area_faces(V, F, rtol=ZERO_AREA_RTOL):
     Faces with a repeated vertex never reach here (:func:`as_mesh` refuses them).
     """
     V, F = as_mesh(V, F)
-    P = V[F]
-    e = P[:, [1, 2, 0]] - P                               # the three edge vectors of each face
-    dblA = np.linalg.norm(np.cross(e[:, 0], -e[:, 2]), axis=1)
-    return np.flatnonzero(is_zero_area(dblA, np.einsum("fij,fij->fi", e, e).max(axis=1), rtol))
+    # coordinate by coordinate (validate sits below geometry, so it cannot call geometry.face_cross)
+    X, Y, Z = np.ascontiguousarray(V.T)
+    i, j, k = np.ascontiguousarray(F.T)
+    ax, ay, az = X[j] - X[i], Y[j] - Y[i], Z[j] - Z[i]       # a = v1 - v0
+    bx, by, bz = X[k] - X[i], Y[k] - Y[i], Z[k] - Z[i]       # b = v2 - v0
+    dblA = np.sqrt((ay * bz - az * by) ** 2 + (az * bx - ax * bz) ** 2 + (ax * by - ay * bx) ** 2)
+    longest2 = np.maximum(np.maximum(ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz),
+                          (bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
+    return np.flatnonzero(is_zero_area(dblA, longest2, rtol))

@@ -1,7 +1,6 @@
 """Tests of geomlib.curvature: closed forms, Gauss-Bonnet, laws, boundary rules, bad input, libigl."""
 
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -1,7 +1,6 @@
 """Tests of geomlib.laplace: closed forms, matrix laws, bad triangles, libigl cross-checks."""
 
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest

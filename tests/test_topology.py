@@ -1,6 +1,5 @@
 """Tests for geomlib.topology: closed-form counts, orientation laws, course meshes."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -314,3 +313,12 @@ def test_edge_face_counts_boundary_counts_and_face_pairs():
     assert E2.tolist() == [[0, 1], [2, 0]] and f1.tolist() == [0, 0] and f2.tolist() == [2, 1]
     # a bow-tie vertex has four boundary edges
     assert boundary_edge_counts(np.array([[0, 1, 2], [0, 3, 4]]))[0] == 4
+
+
+def test_unreferenced_vertices_and_non_manifold_edges():
+    from geomlib.topology import non_manifold_edges, unreferenced_vertices
+
+    F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 5]])
+    assert unreferenced_vertices(F, 7).tolist() == [4, 6]
+    assert non_manifold_edges(F).tolist() == [[0, 1]]
+    assert non_manifold_edges(F[:2]).shape == (0, 2)

@@ -1,6 +1,5 @@
 """Tests for geomlib.validate: as_mesh at the door, check_mesh and MeshReport."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
