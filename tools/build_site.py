@@ -81,6 +81,8 @@ WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
 KERNEL_NOTE = ("In JupyterLab this control recomputes the result; "
                "on this page it stays at its default value.")
+KERNEL_NOTE_MANY = ("In JupyterLab these controls recompute the result; "
+                    "on this page they stay at their default values.")
 
 # ---------------------------------------------------------------------------
 # the pinned JavaScript
@@ -221,8 +223,10 @@ def prepare_for_site(nb):
             if renderers and "image/png" in output["data"]:
                 outputs.append(_html_output(f'<img class="site-still" hidden alt="still picture of the 3D view" '
                                             f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'))
-            if any(_is_control(state[m]) for m in models):
-                outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(KERNEL_NOTE)}</p>'))
+            controls = sum(_is_control(state[m]) for m in models)
+            if controls:
+                note = KERNEL_NOTE if controls == 1 else KERNEL_NOTE_MANY
+                outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(note)}</p>'))
         cell.outputs = outputs
     return live
 
