@@ -14,7 +14,9 @@ static web server and from ``file://``.
 
 Controls that need a kernel (sliders, dropdowns, ...) are shown disabled at
 their default value, with one line saying that they recompute in JupyterLab.
-A view whose widget state was not saved keeps its still picture.
+A view whose widget state was not saved keeps its still picture; so does a
+live view in a browser without WebGL. A cell that raises does not stop the
+build: its page shows the error and the command exits with status 1.
 
 The JavaScript comes from the npm registry, pinned by version and by the
 registry's sha512 integrity hash (:data:`PACKAGES`); downloads are kept in
