@@ -352,7 +352,7 @@ def build(out=OUT, names=None, log=print):
             raise SystemExit(f"{out} is not empty and holds no earlier build of the site; "
                              "choose an empty or new folder")
         shutil.rmtree(out)
-    out.mkdir(parents=True)
+    out.mkdir(parents=True, exist_ok=True)
     install_assets(out)
     pages = []
     executed = []
