@@ -62,6 +62,16 @@ def test_controls_are_disabled_and_noted():
     assert all("site-kernel-note" not in str(o) for o in nb.cells[1].outputs)
 
 
+def test_several_controls_get_one_plural_note():
+    nb, state = _notebook()
+    state["box"]["state"]["children"].append("IPY_MODEL_drop")
+    state["drop"] = _model("DropdownModel", index=0, disabled=False)
+    build_site.prepare_for_site(nb)
+    notes = [o for o in nb.cells[0].outputs if "site-kernel-note" in str(o)]
+    assert len(notes) == 1 and build_site.KERNEL_NOTE_MANY in notes[0]["data"]["text/html"]
+    assert state["drop"]["state"]["disabled"] is True
+
+
 def test_a_view_without_saved_state_keeps_its_still():
     nb, _ = _notebook()
     build_site.prepare_for_site(nb)

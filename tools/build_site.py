@@ -14,7 +14,9 @@ static web server and from ``file://``.
 
 Controls that need a kernel (sliders, dropdowns, ...) are shown disabled at
 their default value, with one line saying that they recompute in JupyterLab.
-A view whose widget state was not saved keeps its still picture.
+A view whose widget state was not saved keeps its still picture; so does a
+live view in a browser without WebGL. A cell that raises does not stop the
+build: its page shows the error and the command exits with status 1.
 
 The JavaScript comes from the npm registry, pinned by version and by the
 registry's sha512 integrity hash (:data:`PACKAGES`); downloads are kept in
@@ -81,6 +83,8 @@ WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
 KERNEL_NOTE = ("In JupyterLab this control recomputes the result; "
                "on this page it stays at its default value.")
+KERNEL_NOTE_MANY = ("In JupyterLab these controls recompute the result; "
+                    "on this page they stay at their default values.")
 
 # ---------------------------------------------------------------------------
 # the pinned JavaScript
@@ -221,8 +225,10 @@ def prepare_for_site(nb):
             if renderers and "image/png" in output["data"]:
                 outputs.append(_html_output(f'<img class="site-still" hidden alt="still picture of the 3D view" '
                                             f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'))
-            if any(_is_control(state[m]) for m in models):
-                outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(KERNEL_NOTE)}</p>'))
+            controls = sum(_is_control(state[m]) for m in models)
+            if controls:
+                note = KERNEL_NOTE if controls == 1 else KERNEL_NOTE_MANY
+                outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(note)}</p>'))
         cell.outputs = outputs
     return live
 
@@ -346,7 +352,7 @@ def build(out=OUT, names=None, log=print):
             raise SystemExit(f"{out} is not empty and holds no earlier build of the site; "
                              "choose an empty or new folder")
         shutil.rmtree(out)
-    out.mkdir(parents=True)
+    out.mkdir(parents=True, exist_ok=True)
     install_assets(out)
     pages = []
     executed = []

@@ -49,7 +49,7 @@ SCREENSHOTS = ROOT / "build" / "screenshots" / "site"
 LOAD_TIMEOUT = 90          # seconds for a page's views and formulas to appear
 LOCAL_SCHEMES = ("file:", "data:", "blob:")
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
 @pytest.fixture(scope="session")
