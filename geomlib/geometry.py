@@ -77,7 +77,8 @@ def enclosed_volume(V, F):
     outside; on an open mesh it depends on the origin (not checked here).
     """
     V, F = as_mesh(V, F)
-    return float(np.einsum("ij,ij->", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])) / 6.0)
+    v0, v1, v2 = corner_positions(V, F)
+    return float(np.einsum("cf,cf->", v0, cross(v1, v2)) / 6.0)
 
 
 def bounding_box_diagonal(V):

@@ -336,10 +336,12 @@ class MeshComparison:
         if not self.samples_per_face >= 0:
             raise MeshError(f"samples_per_face must be >= 0, got {samples_per_face}")
         self.seed = seed
-        _, _, _, boundary, other = interior_edges(self.F)
+        self._interior = interior_edges(self.F)
+        _, _, _, boundary, other = self._interior
         self.closed = len(boundary) == 0 and len(other) == 0
-        self.edges, self.bend_clean = dihedral_angles(self.V_clean, self.F)
+        self.edges, self.bend_clean = dihedral_angles(self.V_clean, self.F, self._interior)
         self.sharp = np.flatnonzero(np.abs(self.bend_clean) > self.sharp_angle)
+        self._sharp_edges = tuple(x[self.sharp] for x in self._interior[:3])
 
     def _check(self, V):
         V = as_vertices(V)
@@ -356,7 +358,7 @@ class MeshComparison:
 
     def sharp_edge_error(self, V):
         """:func:`sharp_edge_error` with this comparison's ``sharp_angle``; NaN without sharp edges."""
-        return sharp_edge_error(self._check(V), self.V_clean, self.F, self.sharp_angle)
+        return sharp_edge_error(self._check(V), self.V_clean, self.F, self.sharp_angle, self._sharp_edges)
 
     def hausdorff(self, V, relative=True, seed=None):
         """:func:`hausdorff_distance` to the clean surface, with this comparison's density and seed."""
@@ -369,7 +371,7 @@ class MeshComparison:
 
     def volume_change(self, V):
         """:func:`volume_change`: ``(vol - vol_clean) / |vol_clean|``; MeshError on an open mesh."""
-        return volume_change(self._check(V), self.V_clean, self.F)
+        return volume_change(self._check(V), self.V_clean, self.F, self._interior)
 
     def evaluate(self, V, hausdorff=True):
         """All metrics of V against the clean mesh, as a dict.
@@ -501,17 +503,18 @@ def area_change(V, V_clean, F):
     return A / A_clean - 1.0
 
 
-def volume_change(V, V_clean, F):
+def volume_change(V, V_clean, F, edges=None):
     """Signed relative change of the enclosed volume, ``(vol - vol_clean) / |vol_clean|``.
 
     Closed meshes only (every edge shared by two opposite faces); an open
-    mesh raises MeshError naming its boundary edges.
+    mesh raises MeshError naming its boundary edges. ``edges``: the result of
+    :func:`interior_edges` for F, to avoid recomputing it.
     """
     V = as_vertices(V)
     V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
     F = as_faces(F, len(V))
-    _, _, _, boundary, other = interior_edges(F)
+    _, _, _, boundary, other = interior_edges(F) if edges is None else edges
     if len(boundary) or len(other):
         bad = np.vstack([boundary, other])
         raise MeshError("the volume change is defined for closed meshes only; "
@@ -534,20 +537,22 @@ def sharp_edges(V_clean, F, threshold=SHARP_ANGLE):
     return E[keep], angle[keep]
 
 
-def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE):
+def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE, edges=None):
     """Mean absolute error (degrees) of the bend (dihedral) angle on the sharp edges.
 
     The sharp edges are the interior edges where the clean mesh bends by more
     than ``threshold`` degrees (default 30); on those the error is
     ``|theta(V) - theta(V_clean)|`` with the signed bend angle of
     :func:`dihedral_angles`. Returns NaN when the clean mesh has no sharp
-    edge (there is nothing to measure).
+    edge (there is nothing to measure). ``edges``: ``(E, f1, f2)`` of
+    :func:`interior_edges` for F (or any subset that holds the sharp edges),
+    to avoid recomputing them.
     """
     V = as_vertices(V)
     V_clean = as_vertices(V_clean, where="V_clean")
     _same_shape(V, V_clean)
     F = as_faces(F, len(V))
-    E, f1, f2, _, _ = interior_edges(F)
+    E, f1, f2 = (interior_edges(F) if edges is None else edges)[:3]
     bend_clean = _bend_angles(V_clean, F, E, f1, f2)
     sharp = np.abs(bend_clean) > threshold
     if not sharp.any():
