@@ -262,15 +262,21 @@ def spectral_basis(V, F, k, weights="cotan", area="barycentric", *, cache=True, 
     A stored basis with more than k eigenpairs serves the request.
     """
     V, F = as_mesh(V, F)
+    basis = _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol)
+    if basis.k == k:
+        return basis
+    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0,
+                         basis.source)
+
+
+def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
+    """The basis in memory, on disk or solved, with at least k eigenpairs (V, F validated)."""
     k, method = _check_k(k, len(V)), _check_method(method)
     name = basis_cache.key(V, F, weights, area) if cache else None
     basis = basis_cache.recall(name) if cache else None
     if basis is None or basis.k < k:
         basis = _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name)
-    if basis.k == k:
-        return basis
-    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0,
-                         basis.source)
+    return basis
 
 
 def _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name):
@@ -307,7 +313,8 @@ def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cac
     V_k : (n, 3) float64, in the units of V.
     """
     if cache:  # the basis of an earlier call: another k only multiplies
-        return spectral_basis(V, F, k, weights, area, cache_dir=cache_dir, method=method).reconstruct(V, k)
+        V, F = as_mesh(V, F)
+        return _stored_basis(V, F, k, weights, area, True, cache_dir, method, None).reconstruct(V, int(k))
     V, F = as_mesh(V, F)
     M, _ = laplacian(V, F, weights=weights, area=area)
     lam, E = eigenbasis(V, F, k, weights, area, cache=False, method=method)
