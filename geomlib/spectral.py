@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import cache as basis_cache
-from .eigen import smallest_eigenpairs
+from .eigen import one_blas_thread, smallest_eigenpairs
 from .errors import MeshError, MeshWarning
 from .laplace import laplacian
 from .requirements import positive_vertex_areas
@@ -237,7 +237,8 @@ class SpectralBasis:
     def reconstruct(self, X, k=None):
         """``E_k E_k^T M X``: the M-orthogonal projection of X onto the first k eigenvectors."""
         k = self._k(k)
-        return self.E[:, :k] @ self.coefficients(X)[:k]
+        with one_blas_thread():  # see geomlib.eigen: a 2-thread pool on a busy 2-core machine is slower
+            return self.E[:, :k] @ self.coefficients(X)[:k]
 
     def residual_norms(self, X):
         """``||X - X_k||_M`` for k = 1 .. self.k, from the coefficients alone (Parseval).
