@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import cache as basis_cache
-from .eigen import smallest_eigenpairs
+from .eigen import one_blas_thread, smallest_eigenpairs
 from .errors import MeshError, MeshWarning
 from .laplace import laplacian
 from .requirements import positive_vertex_areas
@@ -237,7 +237,8 @@ class SpectralBasis:
     def reconstruct(self, X, k=None):
         """``E_k E_k^T M X``: the M-orthogonal projection of X onto the first k eigenvectors."""
         k = self._k(k)
-        return self.E[:, :k] @ self.coefficients(X)[:k]
+        with one_blas_thread():  # see geomlib.eigen: a 2-thread pool on a busy 2-core machine is slower
+            return self.E[:, :k] @ self.coefficients(X)[:k]
 
     def residual_norms(self, X):
         """``||X - X_k||_M`` for k = 1 .. self.k, from the coefficients alone (Parseval).
@@ -262,15 +263,21 @@ def spectral_basis(V, F, k, weights="cotan", area="barycentric", *, cache=True, 
     A stored basis with more than k eigenpairs serves the request.
     """
     V, F = as_mesh(V, F)
+    basis = _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol)
+    if basis.k == k:
+        return basis
+    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0,
+                         basis.source)
+
+
+def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
+    """The basis in memory, on disk or solved, with at least k eigenpairs (V, F validated)."""
     k, method = _check_k(k, len(V)), _check_method(method)
     name = basis_cache.key(V, F, weights, area) if cache else None
     basis = basis_cache.recall(name) if cache else None
     if basis is None or basis.k < k:
         basis = _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name)
-    if basis.k == k:
-        return basis
-    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0,
-                         basis.source)
+    return basis
 
 
 def _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name):
@@ -307,7 +314,8 @@ def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cac
     V_k : (n, 3) float64, in the units of V.
     """
     if cache:  # the basis of an earlier call: another k only multiplies
-        return spectral_basis(V, F, k, weights, area, cache_dir=cache_dir, method=method).reconstruct(V, k)
+        V, F = as_mesh(V, F)
+        return _stored_basis(V, F, k, weights, area, True, cache_dir, method, None).reconstruct(V, int(k))
     V, F = as_mesh(V, F)
     M, _ = laplacian(V, F, weights=weights, area=area)
     lam, E = eigenbasis(V, F, k, weights, area, cache=False, method=method)
