@@ -50,8 +50,7 @@ def _run(cmd, **kw):
 
 # JupyterLab and Notebook 7 settings for .venv: no news or update pop-up for a
 # newcomer to dismiss (it also covers the notebook in screenshots)
-LAB_OVERRIDES = {"@jupyterlab/apputils-extension:notification": {"fetchNews": "false",
-                                                                 "checkForUpdates": False}}
+LAB_OVERRIDES = {"@jupyterlab/apputils-extension:notification": {"fetchNews": "false", "checkForUpdates": False}}
 
 
 def _lab_settings():
@@ -83,11 +82,26 @@ def front_end_command(app, args, root=False):
     """
     first = "/lab/tree/" if app == "lab" else "/notebooks/"
     app_class = "LabApp" if app == "lab" else "JupyterNotebookApp"
-    cmd = [BIN / "jupyter", app, "--notebook-dir", NOTEBOOKS,
-           f"--{app_class}.default_url={first}{FIRST_NOTEBOOK}", *args]
+    cmd = [
+        BIN / "jupyter",
+        app,
+        "--notebook-dir",
+        NOTEBOOKS,
+        f"--{app_class}.default_url={first}{FIRST_NOTEBOOK}",
+        *args,
+    ]
     if root and "--allow-root" not in args:
         cmd.append("--allow-root")  # containers and CI machines often run as root
     return [str(c) for c in cmd]
+
+
+def test_workers(args):
+    """pytest-xdist options for the test command: one worker per core, each notebook file
+    kept whole on one worker (nbval runs a notebook's cells in order in one kernel), unless
+    the arguments choose the workers themselves (``-n 0`` runs everything in one process)."""
+    if any(a == "-n" or a.startswith(("-n", "--numprocesses")) or "xdist" in a for a in args):
+        return []
+    return ["-n", "auto", "--dist", "loadfile"]
 
 
 def main(argv):
@@ -108,7 +122,7 @@ def main(argv):
         cmd = front_end_command(command, rest, root=hasattr(os, "geteuid") and os.geteuid() == 0)
         print("+", " ".join(cmd), flush=True)
         return subprocess.call(cmd, cwd=NOTEBOOKS, env=env)
-    cmd = [PY, "-m", "pytest", *rest]
+    cmd = [PY, "-m", "pytest", *test_workers(rest), *rest]
     print("+", " ".join(str(c) for c in cmd), flush=True)
     return subprocess.call([str(c) for c in cmd], cwd=ROOT, env=env)
 

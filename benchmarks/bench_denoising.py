@@ -31,8 +31,14 @@ import trimesh
 import geomlib
 from geomlib.errors import MeshWarning
 from geomlib.metrics import MeshComparison, denoising_metrics, point_surface_distance, sample_surface
-from geomlib.sweep import (EXPLICIT_FRACTIONS, IMPLICIT_STEPS, SCHEMES, SWEEP_ITERATIONS, scale_free_step,
-                           smoothing_sweep)
+from geomlib.sweep import (
+    EXPLICIT_FRACTIONS,
+    IMPLICIT_STEPS,
+    SCHEMES,
+    SWEEP_ITERATIONS,
+    scale_free_step,
+    smoothing_sweep,
+)
 
 SIGMAS = (0.001, 0.002, 0.005, 0.01, 0.02)
 SEED = 7
@@ -84,19 +90,24 @@ def main():
     c0 = time.process_time()
     t_full = median_time(full, args.repeats)
     cpu_full = (time.process_time() - c0) / args.repeats
-    settings = sum(len(SIGMAS) * (len(EXPLICIT_FRACTIONS) + len(IMPLICIT_STEPS)) * 2 * len(SWEEP_ITERATIONS)
-                   for _ in meshes)
-    print(f"\nfull sweep, both meshes ({settings} settings): {t_full:.2f} s wall clock "
-          f"= {t_full / BUDGET:.2f} of the {BUDGET:.0f} s budget; {cpu_full:.2f} s of processor time per run "
-          f"(wall clock above processor time means other programs shared the cores)")
+    settings = sum(
+        len(SIGMAS) * (len(EXPLICIT_FRACTIONS) + len(IMPLICIT_STEPS)) * 2 * len(SWEEP_ITERATIONS) for _ in meshes
+    )
+    print(
+        f"\nfull sweep, both meshes ({settings} settings): {t_full:.2f} s wall clock "
+        f"= {t_full / BUDGET:.2f} of the {BUDGET:.0f} s budget; {cpu_full:.2f} s of processor time per run "
+        f"(wall clock above processor time means other programs shared the cores)"
+    )
 
     # --- reference: the obvious way, one noise level -------------------------
     sigma = SIGMAS[len(SIGMAS) // 2]
     V, F = meshes["cad_part"]
     t_one = median_time(lambda: smoothing_sweep(V, F, [sigma], SEED, progress=False), args.repeats)
     t_naive = median_time(lambda: naive_sweep(V, F, sigma), 1)
-    print(f"one noise level on cad_part: sweep {t_one:.2f} s, one call per setting {t_naive:.2f} s "
-          f"-> ratio {t_naive / t_one:.1f}x")
+    print(
+        f"one noise level on cad_part: sweep {t_one:.2f} s, one call per setting {t_naive:.2f} s "
+        f"-> ratio {t_naive / t_one:.1f}x"
+    )
 
     # --- metrics --------------------------------------------------------------
     V, F = meshes["sphere"]
@@ -106,8 +117,10 @@ def main():
     t_eval = median_time(lambda: cmp.evaluate(W, hausdorff=False), 20)
     t_func = median_time(lambda: denoising_metrics(W, V, F), 3)
     t_eval_h = median_time(lambda: cmp.evaluate(W), 5)
-    print(f"\nmetrics on sphere: evaluate without Hausdorff {1e3 * t_eval:.2f} ms, with {1e3 * t_eval_h:.1f} ms; "
-          f"denoising_metrics (rebuilds the clean data) {1e3 * t_func:.1f} ms")
+    print(
+        f"\nmetrics on sphere: evaluate without Hausdorff {1e3 * t_eval:.2f} ms, with {1e3 * t_eval_h:.1f} ms; "
+        f"denoising_metrics (rebuilds the clean data) {1e3 * t_func:.1f} ms"
+    )
 
     P = np.vstack([W, sample_surface(W, F, 2 * len(F), seed=1)])
     t_ours = median_time(lambda: point_surface_distance(P, V, F), args.repeats)
@@ -115,15 +128,19 @@ def main():
     t_tri = median_time(lambda: trimesh.proximity.closest_point(mesh, P), 1)
     d_ours = point_surface_distance(P, V, F)
     d_tri = trimesh.proximity.closest_point(mesh, P)[1]
-    line = (f"{len(P)} point-to-surface distances: geomlib {1e3 * t_ours:.0f} ms, trimesh {1e3 * t_tri:.0f} ms "
-            f"-> ratio {t_tri / t_ours:.1f}x (max difference {np.abs(d_ours - d_tri).max():.1e})")
+    line = (
+        f"{len(P)} point-to-surface distances: geomlib {1e3 * t_ours:.0f} ms, trimesh {1e3 * t_tri:.0f} ms "
+        f"-> ratio {t_tri / t_ours:.1f}x (max difference {np.abs(d_ours - d_tri).max():.1e})"
+    )
     try:
         import igl
 
         t_igl = median_time(lambda: igl.point_mesh_squared_distance(P, V, F), args.repeats)
         d_igl = np.sqrt(igl.point_mesh_squared_distance(P, V, F)[0])
-        line += (f"; libigl {1e3 * t_igl:.0f} ms -> ratio {t_igl / t_ours:.2f}x "
-                 f"(max difference {np.abs(d_ours - d_igl).max():.1e})")
+        line += (
+            f"; libigl {1e3 * t_igl:.0f} ms -> ratio {t_igl / t_ours:.2f}x "
+            f"(max difference {np.abs(d_ours - d_igl).max():.1e})"
+        )
     except ImportError:
         line += "; libigl not installed"
     print(line)

@@ -117,13 +117,19 @@ def best_time(fn, V, F, repeat):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--levels", type=int, nargs="+", default=[6, 7, 8],
-                        help="icosphere subdivision levels (6, 7, 8: 40962, 163842, 655362 vertices)")
+    parser.add_argument(
+        "--levels",
+        type=int,
+        nargs="+",
+        default=[6, 7, 8],
+        help="icosphere subdivision levels (6, 7, 8: 40962, 163842, 655362 vertices)",
+    )
     parser.add_argument("--repeat", type=int, default=5, help="timed repetitions (best is kept)")
     parser.add_argument("--ops", nargs="+", default=list(OPS), choices=OPS)
     parser.add_argument("--no-memory", action="store_true", help="skip the subprocess memory measurement")
-    parser.add_argument("--json", metavar="PATH", help="also save the results as JSON (notebook 03 reads "
-                        "benchmarks/bench_laplace.json)")
+    parser.add_argument(
+        "--json", metavar="PATH", help="also save the results as JSON (notebook 03 reads benchmarks/bench_laplace.json)"
+    )
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -136,8 +142,10 @@ def main():
 
     results = []
 
-    print(f"{'vertices':>9} {'operation':<13} {'geomlib s':>10} {'libigl s':>9} {'time':>6} "
-          f"{'geomlib MB':>10} {'libigl MB':>9} {'memory':>6}")
+    print(
+        f"{'vertices':>9} {'operation':<13} {'geomlib s':>10} {'libigl s':>9} {'time':>6} "
+        f"{'geomlib MB':>10} {'libigl MB':>9} {'memory':>6}"
+    )
     with tempfile.TemporaryDirectory() as tmp:
         for level in args.levels:
             V, F = icosphere(level)
@@ -157,17 +165,36 @@ def main():
                 else:
                     ma, mb = peak_memory(path, "geomlib", op), peak_memory(path, "libigl", op)
                 mr = ma / mb if mb > 0 else float("nan")
-                print(f"{len(V):>9} {op:<13} {ta:>10.3f} {tb:>9.3f} {ta / tb:>5.2f}x "
-                      f"{ma / 2**20:>10.1f} {mb / 2**20:>9.1f} {mr:>5.2f}x", flush=True)
-                results.append(dict(vertices=len(V), operation=op, geomlib_s=ta, libigl_s=tb, time_ratio=ta / tb,
-                                    geomlib_peak_mb=ma / 2**20, libigl_peak_mb=mb / 2**20, memory_ratio=mr))
+                print(
+                    f"{len(V):>9} {op:<13} {ta:>10.3f} {tb:>9.3f} {ta / tb:>5.2f}x "
+                    f"{ma / 2**20:>10.1f} {mb / 2**20:>9.1f} {mr:>5.2f}x",
+                    flush=True,
+                )
+                results.append(
+                    dict(
+                        vertices=len(V),
+                        operation=op,
+                        geomlib_s=ta,
+                        libigl_s=tb,
+                        time_ratio=ta / tb,
+                        geomlib_peak_mb=ma / 2**20,
+                        libigl_peak_mb=mb / 2**20,
+                        memory_ratio=mr,
+                    )
+                )
     if args.json:
         import igl
         import scipy
 
-        meta = dict(python=platform.python_version(), numpy=np.__version__, scipy=scipy.__version__,
-                    libigl=getattr(igl, "__version__", "unknown"), machine=platform.machine(),
-                    cpus=os.cpu_count(), repeat=args.repeat)
+        meta = dict(
+            python=platform.python_version(),
+            numpy=np.__version__,
+            scipy=scipy.__version__,
+            libigl=getattr(igl, "__version__", "unknown"),
+            machine=platform.machine(),
+            cpus=os.cpu_count(),
+            repeat=args.repeat,
+        )
         Path(args.json).write_text(json.dumps(dict(meta=meta, results=results), indent=1) + "\n")
 
 

@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT / "tests" / "browser"))
 
 import lablib  # noqa: E402
 
-SIZES = [(4, 2562, 150), (6, 40962, 300), (7, 163842, 800)]   # icosphere level, vertices, target ms
+SIZES = [(4, 2562, 150), (6, 40962, 300), (7, 163842, 800)]  # icosphere level, vertices, target ms
 
 SETUP = r'''
 import time
@@ -100,7 +100,7 @@ def make(level, naive):
 '''
 
 # in-page instrumentation: frame times after draws, per canvas, and the last key press
-INIT_SCRIPT = r'''
+INIT_SCRIPT = r"""
 (() => {
   window.__frames = [];
   window.__key = 0;
@@ -135,9 +135,9 @@ INIT_SCRIPT = r'''
     };
   }
 })();
-'''
+"""
 
-JS_LAST_FRAME = r'''
+JS_LAST_FRAME = r"""
 (sel) => {
   const canvas = document.querySelector(sel + ' .geomlib-canvas canvas');
   const key = window.__key;
@@ -148,15 +148,18 @@ JS_LAST_FRAME = r'''
           last_message: msgs.length ? msgs[msgs.length - 1].t : null,
           bytes: msgs.reduce((a, m) => a + m.size, 0), now: performance.now()};
 }
-'''
+"""
 
 
 def notebook_json(cells):
     return {
-        "nbformat": 4, "nbformat_minor": 5,
+        "nbformat": 4,
+        "nbformat_minor": 5,
         "metadata": {"kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"}},
-        "cells": [{"cell_type": "code", "id": f"c{i}", "metadata": {}, "execution_count": None,
-                   "outputs": [], "source": src} for i, src in enumerate(cells)],
+        "cells": [
+            {"cell_type": "code", "id": f"c{i}", "metadata": {}, "execution_count": None, "outputs": [], "source": src}
+            for i, src in enumerate(cells)
+        ],
     }
 
 
@@ -208,7 +211,7 @@ def measure(page, selector, reps, settle=0.8, timeout=30.0):
     latencies, arrivals, messages = [], [], []
     changed = None
     for r in range(reps):
-        key = "ArrowRight" if (r // 5) % 2 == 0 else "ArrowLeft"   # stay inside the slider's range
+        key = "ArrowRight" if (r // 5) % 2 == 0 else "ArrowLeft"  # stay inside the slider's range
         page.keyboard.press(key)
         deadline = time.monotonic() + timeout
         last_seen, quiet_since = None, time.monotonic()
@@ -245,8 +248,11 @@ def main():
         for level, n, _ in SIZES:
             cells.append(f"make({level}, naive={variant == 'naive'})")
 
-    print("python side, MeshView.update alone (median ms):",
-          ", ".join(f"{n}: {t:.0f}" for n, t in python_side(SIZES).items()), flush=True)
+    print(
+        "python side, MeshView.update alone (median ms):",
+        ", ".join(f"{n}: {t:.0f}" for n, t in python_side(SIZES).items()),
+        flush=True,
+    )
     print(f"still picture of the display fallback, 25,600 faces: {still_time():.0f} ms (goal < 300)", flush=True)
 
     with tempfile.TemporaryDirectory(prefix="bench-slider-") as tmp:
@@ -267,11 +273,14 @@ def main():
                     results[(variant, n)] = statistics.median(lat)
                     arrive = f"{statistics.median(arrivals):.0f}" if arrivals else "?"
                     count, size = messages[len(messages) // 2] if messages else (0, 0)
-                    print(f"{variant:8s} {n:7d} vertices: median {statistics.median(lat):6.0f} ms "
-                          f"(min {min(lat):.0f}, max {max(lat):.0f}, {len(lat)} presses); "
-                          f"last update message in the browser after {arrive} ms "
-                          f"({count} large message(s), {size / 1e6:.1f} MB); "
-                          f"{changed:.0%} of the canvas changed", flush=True)
+                    print(
+                        f"{variant:8s} {n:7d} vertices: median {statistics.median(lat):6.0f} ms "
+                        f"(min {min(lat):.0f}, max {max(lat):.0f}, {len(lat)} presses); "
+                        f"last update message in the browser after {arrive} ms "
+                        f"({count} large message(s), {size / 1e6:.1f} MB); "
+                        f"{changed:.0%} of the canvas changed",
+                        flush=True,
+                    )
             lablib.shutdown_kernel(page)
 
     print("\nkey press -> final image, median ms")

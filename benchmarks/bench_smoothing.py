@@ -55,7 +55,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 ITERATIONS = 10
-SLIDER_ITERATIONS = 5      # iterations behind each slider setting (notebook 06 starts at 3)
+SLIDER_ITERATIONS = 5  # iterations behind each slider setting (notebook 06 starts at 3)
 STEP_SCALE_FREE = 10.0
 
 
@@ -108,9 +108,11 @@ def bench_sizes(levels, repeat, cg):
                 t, P_cg = timed(ours, V, F, step, ITERATIONS, solver="cg")
                 best["cg"] = min(best["cg"], t)
         diff = np.abs(P_ours - P_base).max() / edge
-        line = (f"{len(V):>8,d} vertices  ours {best['ours']:8.2f} s  spsolve x{ITERATIONS} "
-                f"{best['spsolve']:8.2f} s  ratio {best['ours'] / best['spsolve']:.3f}  "
-                f"max diff {diff:.1e} edge lengths")
+        line = (
+            f"{len(V):>8,d} vertices  ours {best['ours']:8.2f} s  spsolve x{ITERATIONS} "
+            f"{best['spsolve']:8.2f} s  ratio {best['ours'] / best['spsolve']:.3f}  "
+            f"max diff {diff:.1e} edge lengths"
+        )
         if cg:
             line += f"  | cg {best['cg']:.2f} s ratio {best['cg'] / best['spsolve']:.3f}"
         print(line, flush=True)
@@ -121,8 +123,7 @@ def bench_sizes(levels, repeat, cg):
 def slider_meshes():
     import trimesh
 
-    m = trimesh.creation.torus(major_radius=1.0, minor_radius=0.35, major_sections=200,
-                               minor_sections=125)
+    m = trimesh.creation.torus(major_radius=1.0, minor_radius=0.35, major_sections=200, minor_sections=125)
     yield "torus", np.asarray(m.vertices, float), np.asarray(m.faces, np.int64)
     course = ROOT.parent / "shared" / "meshes" / "decomposition" / "armadillo.obj"
     if course.exists():
@@ -137,7 +138,7 @@ def bench_slider(repeat):
     from geomlib import ImplicitSmoother
     from geomlib.viewer import MeshView
 
-    slider = 10.0 ** np.arange(-1.0, 3.01, 0.25)   # the notebook's FloatLogSlider positions (step / h^2)
+    slider = 10.0 ** np.arange(-1.0, 3.01, 0.25)  # the notebook's FloatLogSlider positions (step / h^2)
     for name, V, F in slider_meshes():
         h2 = np.linalg.norm(V[F[:, 0]] - V[F[:, 1]], axis=1).mean() ** 2
         steps = slider * h2
@@ -163,14 +164,14 @@ def bench_slider(repeat):
         step_moves, iteration_moves, revisits = [], [], []
         for _ in range(repeat):
             for s in rng.permutation(steps)[:6]:
-                step_moves.append(callback(s, SLIDER_ITERATIONS))            # iterates prepared
-                iteration_moves.append(callback(s, SLIDER_ITERATIONS + 1))   # iteration slider +1
-                revisits.append(callback(s, SLIDER_ITERATIONS + 1))          # a setting seen before
+                step_moves.append(callback(s, SLIDER_ITERATIONS))  # iterates prepared
+                iteration_moves.append(callback(s, SLIDER_ITERATIONS + 1))  # iteration slider +1
+                revisits.append(callback(s, SLIDER_ITERATIONS + 1))  # a setting seen before
             smoother._history.clear()
             smoother.prepare(steps, SLIDER_ITERATIONS)
         unprepared = []
         for s in rng.permutation(steps)[:6]:
-            smoother._history.pop((float(s), False), None)    # factorised, iterates not kept
+            smoother._history.pop((float(s), False), None)  # factorised, iterates not kept
             unprepared.append(callback(s, SLIDER_ITERATIONS))
         fresh = ImplicitSmoother(V, F)
         t = time.perf_counter()
@@ -180,15 +181,18 @@ def bench_slider(repeat):
         def ms(x):
             return f"median {np.median(x) * 1e3:.0f} ms (max {np.max(x) * 1e3:.0f})"
 
-        print(f"slider, {name}, {len(V):,d} vertices, {SLIDER_ITERATIONS} iterations (target 150 ms):\n"
-              f"  outside the callback: operator {t_operator * 1e3:.0f} ms, factorising the "
-              f"{len(steps)} slider step values {t_prepare:.2f} s, their first {SLIDER_ITERATIONS} "
-              f"iterates {t_iterates:.2f} s\n"
-              f"  step slider moved: {ms(step_moves)}\n"
-              f"  iteration slider moved one past the prepared iterates: {ms(iteration_moves)}\n"
-              f"  setting seen before: {ms(revisits)}\n"
-              f"  for comparison: step factorised but iterates not prepared {ms(unprepared)}; "
-              f"a step never factorised {t_cold * 1e3:.0f} ms", flush=True)
+        print(
+            f"slider, {name}, {len(V):,d} vertices, {SLIDER_ITERATIONS} iterations (target 150 ms):\n"
+            f"  outside the callback: operator {t_operator * 1e3:.0f} ms, factorising the "
+            f"{len(steps)} slider step values {t_prepare:.2f} s, their first {SLIDER_ITERATIONS} "
+            f"iterates {t_iterates:.2f} s\n"
+            f"  step slider moved: {ms(step_moves)}\n"
+            f"  iteration slider moved one past the prepared iterates: {ms(iteration_moves)}\n"
+            f"  setting seen before: {ms(revisits)}\n"
+            f"  for comparison: step factorised but iterates not prepared {ms(unprepared)}; "
+            f"a step never factorised {t_cold * 1e3:.0f} ms",
+            flush=True,
+        )
 
 
 def bench_limit():
@@ -207,9 +211,12 @@ def bench_limit():
             S = (d @ (-C) @ d).tocsr()
             v0 = np.random.default_rng(0).standard_normal(len(V))
             t_ref, lam = timed(sla.eigsh, S, k=1, which="LA", v0=v0, tol=1e-8)
-            print(f"step limit, {name} {len(V):,d} vertices, {weights}: first call {t_first:.2f} s, "
-                  f"cached {t_cached * 1e3:.2f} ms; eigsh {t_ref:.2f} s; ratio {t_first / t_ref:.2f}; "
-                  f"2 / lam_max agree to {abs(limit * lam[0][0] / 2 - 1):.1e}", flush=True)
+            print(
+                f"step limit, {name} {len(V):,d} vertices, {weights}: first call {t_first:.2f} s, "
+                f"cached {t_cached * 1e3:.2f} ms; eigsh {t_ref:.2f} s; ratio {t_first / t_ref:.2f}; "
+                f"2 / lam_max agree to {abs(limit * lam[0][0] / 2 - 1):.1e}",
+                flush=True,
+            )
 
 
 def main():
@@ -220,8 +227,10 @@ def main():
     parser.add_argument("--no-slider", action="store_true")
     parser.add_argument("--limit", action="store_true", help="also time explicit_step_limit")
     args = parser.parse_args()
-    print(f"implicit smoothing, {ITERATIONS} iterations, operator fixed, step = "
-          f"{STEP_SCALE_FREE:g} mean edge length^2; ratio = ours / spsolve every iteration")
+    print(
+        f"implicit smoothing, {ITERATIONS} iterations, operator fixed, step = "
+        f"{STEP_SCALE_FREE:g} mean edge length^2; ratio = ours / spsolve every iteration"
+    )
     bench_sizes(args.levels, args.repeat, args.cg)
     if not args.no_slider:
         bench_slider(max(args.repeat, 3))

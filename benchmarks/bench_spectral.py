@@ -90,13 +90,23 @@ def bench_eigenbasis(cases, repeat):
                 t, _ = timed(reference, V, F, k)
             t_ref1.append(t)
         rel = np.abs(lam[1:] - lam_ref[1:]) / lam_ref[1:]
-        row = dict(vertices=n, k=k, reference_s=min(t_ref), reference_1thread_s=min(t_ref1),
-                   geomlib_s=min(t_geo), ratio=min(t_geo) / min(t_ref),
-                   ratio_1thread=min(t_geo) / min(t_ref1), max_rel_eigenvalue_diff=float(rel.max()))
+        row = dict(
+            vertices=n,
+            k=k,
+            reference_s=min(t_ref),
+            reference_1thread_s=min(t_ref1),
+            geomlib_s=min(t_geo),
+            ratio=min(t_geo) / min(t_ref),
+            ratio_1thread=min(t_geo) / min(t_ref1),
+            max_rel_eigenvalue_diff=float(rel.max()),
+        )
         rows.append(row)
-        print(f"{n:7d} {k:4d}  eigsh {row['reference_s']:7.2f} s  (1 thread {row['reference_1thread_s']:7.2f} s)  "
-              f"geomlib {row['geomlib_s']:7.2f} s  ratio {row['ratio']:.2f}  (vs 1 thread {row['ratio_1thread']:.2f})  "
-              f"max rel. eigenvalue difference {row['max_rel_eigenvalue_diff']:.1e}", flush=True)
+        print(
+            f"{n:7d} {k:4d}  eigsh {row['reference_s']:7.2f} s  (1 thread {row['reference_1thread_s']:7.2f} s)  "
+            f"geomlib {row['geomlib_s']:7.2f} s  ratio {row['ratio']:.2f}  (vs 1 thread {row['ratio_1thread']:.2f})  "
+            f"max rel. eigenvalue difference {row['max_rel_eigenvalue_diff']:.1e}",
+            flush=True,
+        )
     return rows
 
 
@@ -114,11 +124,21 @@ def bench_cache_and_slider(k=200):
             dt, _ = timed(spectral_reconstruction, V, F, int(kk), cache_dir=folder)
             times.append(dt)
     basis_cache.forget()
-    out = dict(vertices=n, k=k, cold_s=cold, warm_cache_s=warm_disk, memory_s=warm_memory,
-               slider_ms_median=1e3 * float(np.median(times)), slider_ms_max=1e3 * float(np.max(times)))
-    print(f"cache, {n} vertices, k = {k}: cold {cold:.2f} s, warm from disk {warm_disk:.3f} s, "
-          f"from memory {warm_memory * 1e3:.1f} ms; spectral_reconstruction for a new k: median "
-          f"{out['slider_ms_median']:.1f} ms, max {out['slider_ms_max']:.1f} ms", flush=True)
+    out = dict(
+        vertices=n,
+        k=k,
+        cold_s=cold,
+        warm_cache_s=warm_disk,
+        memory_s=warm_memory,
+        slider_ms_median=1e3 * float(np.median(times)),
+        slider_ms_max=1e3 * float(np.max(times)),
+    )
+    print(
+        f"cache, {n} vertices, k = {k}: cold {cold:.2f} s, warm from disk {warm_disk:.3f} s, "
+        f"from memory {warm_memory * 1e3:.1f} ms; spectral_reconstruction for a new k: median "
+        f"{out['slider_ms_median']:.1f} ms, max {out['slider_ms_max']:.1f} ms",
+        flush=True,
+    )
     return out
 
 
@@ -129,8 +149,12 @@ def main():
     parser.add_argument("--json", type=Path, help="save the results here")
     args = parser.parse_args()
     cases = [c for c in CASES if c[0] == 5] if args.quick else CASES
-    print(f"geomlib {geomlib.__version__}, numpy {np.__version__}, scipy {scipy.__version__}, "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}" if hasattr(os, "getloadavg") else "")
+    print(
+        f"geomlib {geomlib.__version__}, numpy {np.__version__}, scipy {scipy.__version__}, "
+        f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}"
+        if hasattr(os, "getloadavg")
+        else ""
+    )
     rows = bench_eigenbasis(cases, args.repeat)
     cache = bench_cache_and_slider()
     if args.json:
@@ -139,9 +163,13 @@ def main():
             warm_cache_s=round(cache["warm_cache_s"], 3),
             slider_ms=round(cache["slider_ms_median"], 1),
             cache=cache,
-            machine=dict(python=platform.python_version(), numpy=np.__version__, scipy=scipy.__version__,
-                         cpus=os.cpu_count(),
-                         load_average=os.getloadavg()[0] if hasattr(os, "getloadavg") else None),
+            machine=dict(
+                python=platform.python_version(),
+                numpy=np.__version__,
+                scipy=scipy.__version__,
+                cpus=os.cpu_count(),
+                load_average=os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+            ),
             date=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         )
         args.json.write_text(json.dumps(result, indent=1) + "\n")

@@ -20,7 +20,7 @@ symbolic module is ``geomlib.symbolic``.
 
 from importlib import import_module
 
-from .errors import MeshError, MeshWarning
+from .errors import MeshError, MeshWarning  # noqa: F401  (public names, listed in __all__)
 
 __version__ = "0.1.0"
 import_module(".frontends", __name__).enable_colab_widgets()  # Colab draws the 3D views only after this

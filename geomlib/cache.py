@@ -128,8 +128,11 @@ def load(where, name, k):
     """
     if where.exists() and not where.is_dir():
         return None  # reported by store(), which cannot write there either
-    candidates = sorted((kk, p) for p in where.glob(f"{name}-k*.npz")
-                        if (kk := _stored_k(p)) is not None and kk >= k) if where.is_dir() else []
+    candidates = (
+        sorted((kk, p) for p in where.glob(f"{name}-k*.npz") if (kk := _stored_k(p)) is not None and kk >= k)
+        if where.is_dir()
+        else []
+    )
     if not candidates:
         return None
     kk, path = candidates[0]
@@ -139,8 +142,7 @@ def load(where, name, k):
         if E.ndim != 2 or E.shape[1] != kk or lam.shape != (kk,):
             raise ValueError(f"arrays of shape {lam.shape} and {E.shape}, expected ({kk},) and (n, {kk})")
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
-        _warn(f"the cached eigenbasis {path} is damaged ({type(exc).__name__}: {exc}); "
-              f"solving again and replacing it")
+        _warn(f"the cached eigenbasis {path} is damaged ({type(exc).__name__}: {exc}); solving again and replacing it")
         try:
             path.unlink()
         except OSError:
@@ -153,8 +155,10 @@ def store(where, name, lam, E):
     """Write a basis; smaller stored bases of the same key are deleted. Never raises:
     a folder that cannot be written gives a MeshWarning and the basis is just not stored."""
     if where.exists() and not where.is_dir():
-        _warn(f"the eigenbasis cache folder {where} is a file, not a folder, so the basis "
-              f"is not stored (delete or move that file, or set GEOMLIB_CACHE_DIR)")
+        _warn(
+            f"the eigenbasis cache folder {where} is a file, not a folder, so the basis "
+            f"is not stored (delete or move that file, or set GEOMLIB_CACHE_DIR)"
+        )
         return
     path = where / f"{name}-k{len(lam)}.npz"
     tmp = where / f".{name}-{os.getpid()}-{time.monotonic_ns()}.tmp.npz"
@@ -163,8 +167,10 @@ def store(where, name, lam, E):
         np.savez(tmp, lam=lam, E=E)
         os.replace(tmp, path)  # atomic: a reader never sees half a file
     except OSError as exc:
-        _warn(f"could not write the eigenbasis cache in {where} ({type(exc).__name__}: {exc}); "
-              f"the basis is not stored and will be solved again next time")
+        _warn(
+            f"could not write the eigenbasis cache in {where} ({type(exc).__name__}: {exc}); "
+            f"the basis is not stored and will be solved again next time"
+        )
         try:
             tmp.unlink(missing_ok=True)
         except OSError:

@@ -102,9 +102,11 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
     M, C = laplacian(V, F, weights, area)
     A = M.diagonal()
     if (A <= 0).any():
-        _warn(f"{(A <= 0).sum()} vertex/vertices belong to no triangle of non-zero area; their curvature "
-              f"is undefined and returned as NaN: vertices {format_indices(np.flatnonzero(A <= 0))}")
-    DV = (C @ V) / np.where(A > 0, A, np.nan)[:, None]        # Delta x = M^-1 C x
+        _warn(
+            f"{(A <= 0).sum()} vertex/vertices belong to no triangle of non-zero area; their curvature "
+            f"is undefined and returned as NaN: vertices {format_indices(np.flatnonzero(A <= 0))}"
+        )
+    DV = (C @ V) / np.where(A > 0, A, np.nan)[:, None]  # Delta x = M^-1 C x
     if signed:
         H = -0.5 * np.einsum("ij,ij->i", DV, vertex_normals(V, F))
     else:
@@ -113,8 +115,10 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
         on_boundary = boundary_mask(V, F)
         H[on_boundary] = np.nan if boundary == "nan" else 0.0
         if on_boundary.all():
-            _warn(f"every vertex of this mesh lies on the boundary; boundary={boundary!r} gives "
-                  f"{'NaN' if boundary == 'nan' else '0'} everywhere (boundary='formula' keeps the values)")
+            _warn(
+                f"every vertex of this mesh lies on the boundary; boundary={boundary!r} gives "
+                f"{'NaN' if boundary == 'nan' else '0'} everywhere (boundary='formula' keeps the values)"
+            )
     return H
 
 
@@ -127,7 +131,7 @@ def corner_angles(V, F):
     every triangle sum to pi.
     """
     l2, dblA, _, degenerate = face_geometry(V, F)
-    l2 = l2.T                                                  # (3, m): one row per corner
+    l2 = l2.T  # (3, m): one row per corner
     theta = np.arctan2(dblA, 0.5 * l2.sum(axis=0) - l2)
     flat = np.flatnonzero(degenerate)
     theta[:, flat] = 0.0
@@ -154,8 +158,10 @@ def angle_deficit(V, F):
     deficit = 2.0 * np.pi - angle_sums(V, F)
     unreferenced = np.bincount(F.ravel(), minlength=len(V)) == 0
     if unreferenced.any():
-        _warn(f"{unreferenced.sum()} vertex/vertices are in no triangle; K is NaN there: "
-              f"vertices {format_indices(np.flatnonzero(unreferenced))}")
+        _warn(
+            f"{unreferenced.sum()} vertex/vertices are in no triangle; K is NaN there: "
+            f"vertices {format_indices(np.flatnonzero(unreferenced))}"
+        )
         deficit[unreferenced] = np.nan
     return deficit
 
@@ -196,13 +202,13 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
     if boundary not in BOUNDARY_RULES:
         raise MeshError(f"boundary must be one of {BOUNDARY_RULES}, not {boundary!r}")
     V, F = as_mesh(V, F)
-    K = angle_deficit(V, F)                                     # 2 pi - sum theta
+    K = angle_deficit(V, F)  # 2 pi - sum theta
     if boundary != "deficit":
         E, faces_at_edge = edge_face_counts(F, len(V))
         b = np.bincount(E[faces_at_edge == 1].ravel(), minlength=len(V))  # boundary edges at each vertex
         on_boundary = b > 0
         if boundary == "turning":
-            K[on_boundary] -= 0.5 * np.pi * b[on_boundary]      # b = 2: pi - sum theta
+            K[on_boundary] -= 0.5 * np.pi * b[on_boundary]  # b = 2: pi - sum theta
         else:
             K[on_boundary] = np.nan if boundary == "nan" else 0.0
         _warn_unusual_boundary(E[faces_at_edge > 2], on_boundary, boundary)
@@ -210,8 +216,10 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
         return K
     A = vertex_areas(V, F, area)
     if (A <= 0).any():
-        _warn(f"{(A <= 0).sum()} vertex/vertices have zero area (in no triangle of non-zero area); "
-              f"K is NaN there: vertices {format_indices(np.flatnonzero(A <= 0))}")
+        _warn(
+            f"{(A <= 0).sum()} vertex/vertices have zero area (in no triangle of non-zero area); "
+            f"K is NaN there: vertices {format_indices(np.flatnonzero(A <= 0))}"
+        )
     return K / np.where(A > 0, A, np.nan)
 
 
@@ -219,11 +227,15 @@ def _warn_unusual_boundary(non_manifold_edges, on_boundary, boundary):
     if len(non_manifold_edges):
         listed = ", ".join(f"({a}, {b})" for a, b in non_manifold_edges[:5].tolist())
         more = f" (and {len(non_manifold_edges) - 5} more)" if len(non_manifold_edges) > 5 else ""
-        _warn(f"{len(non_manifold_edges)} edge(s) belong to three or more triangles; they count as "
-              f"interior edges: {listed}{more}")
+        _warn(
+            f"{len(non_manifold_edges)} edge(s) belong to three or more triangles; they count as "
+            f"interior edges: {listed}{more}"
+        )
     if on_boundary.all():
-        _warn(f"every vertex of this mesh lies on the boundary; the angle deficit is defined nowhere "
-              f"(boundary={boundary!r} gives {'NaN everywhere' if boundary == 'nan' else 'the rule at every vertex'})")
+        _warn(
+            f"every vertex of this mesh lies on the boundary; the angle deficit is defined nowhere "
+            f"(boundary={boundary!r} gives {'NaN everywhere' if boundary == 'nan' else 'the rule at every vertex'})"
+        )
 
 
 def principal_curvatures(H, K):

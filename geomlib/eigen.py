@@ -32,8 +32,14 @@ from threadpoolctl import ThreadpoolController
 from .factor import factor_seconds, factorise
 from .progress import Stages
 
-__all__ = ["DENSE_MAX", "smallest_eigenpairs", "largest_eigenpair", "largest_eigenvalue", "one_blas_thread",
-           "solve_seconds"]
+__all__ = [
+    "DENSE_MAX",
+    "smallest_eigenpairs",
+    "largest_eigenpair",
+    "largest_eigenvalue",
+    "one_blas_thread",
+    "solve_seconds",
+]
 
 #: Matrices of at most this size are solved with dense LAPACK.
 DENSE_MAX = 600
@@ -139,8 +145,7 @@ def largest_eigenvalue(S, rtol=1e-8, maxiter=500):
         beta = float(np.sqrt(w @ w))
         last = j == min(maxiter, n) - 1 or beta <= 1e-14 * abs(alpha)
         if j % 5 == 4 or last:  # the top eigenvalue of the tridiagonal matrix T_j
-            theta = la.eigvalsh_tridiagonal(np.array(alphas), np.array(betas), select="i",
-                                            select_range=(j, j))[0]
+            theta = la.eigvalsh_tridiagonal(np.array(alphas), np.array(betas), select="i", select_range=(j, j))[0]
             history.append(theta)
             if last or (len(history) > 2 and history[-1] - history[-3] <= rtol * abs(theta)):
                 return float(theta)

@@ -55,8 +55,12 @@ class Factor:
         A.sum_duplicates()
         try:
             self._solver = CholeskySolverD(
-                self.n, A.indptr.astype(np.int32), A.indices.astype(np.int32),
-                np.ascontiguousarray(A.data), MatrixType.CSR)
+                self.n,
+                A.indptr.astype(np.int32),
+                A.indices.astype(np.int32),
+                np.ascontiguousarray(A.data),
+                MatrixType.CSR,
+            )
         except ValueError as exc:  # cholespy: "Matrix is not positive definite!"
             raise np.linalg.LinAlgError(f"the matrix is not positive definite ({exc})") from None
 

@@ -71,17 +71,25 @@ def plot_mode_factors(lam_min, lam_max, tau, taubin=None, ax=None, title=None):
 
     ax = ax or plt.subplots(figsize=(7, 3.6))[1]
     lam = np.linspace(0.0, 1.15 * lam_max, 600)
-    for scheme, style in (("diffusion", "k-"), ("explicit", "C3-"), ("implicit", "C0-"),
-                          ("crank-nicolson", "C2--")):
+    for scheme, style in (("diffusion", "k-"), ("explicit", "C3-"), ("implicit", "C0-"), ("crank-nicolson", "C2--")):
         ax.plot(lam, mode_factor(lam, tau, scheme), style, lw=1.4, label=scheme)
     if taubin is not None:
-        ax.plot(lam, mode_factor(lam, taubin[0], "taubin", taubin[1]), "C1-", lw=1.4,
-                label=f"Taubin ({taubin[0]:.3g}, {taubin[1]:.3g})")
+        ax.plot(
+            lam,
+            mode_factor(lam, taubin[0], "taubin", taubin[1]),
+            "C1-",
+            lw=1.4,
+            label=f"Taubin ({taubin[0]:.3g}, {taubin[1]:.3g})",
+        )
     ax.axvspan(lam_min, lam_max, color="0.9", zorder=0, label="this mesh's eigenvalues")
     ax.axhline(0, color="0.5", lw=0.6)
     for y in (-1, 1):
         ax.axhline(y, color="0.5", lw=0.6, ls=":")
-    ax.set(xlabel=r"eigenvalue $\lambda$", ylabel="factor per step", ylim=(-2.2, 1.2),
-           title=title or rf"one step, $\tau$ = {tau:.3g}")
+    ax.set(
+        xlabel=r"eigenvalue $\lambda$",
+        ylabel="factor per step",
+        ylim=(-2.2, 1.2),
+        title=title or rf"one step, $\tau$ = {tau:.3g}",
+    )
     ax.legend(fontsize=8, loc="lower left")
     return ax

@@ -29,7 +29,7 @@ def in_colab():
         return True
     try:
         return importlib.util.find_spec(COLAB) is not None
-    except (ImportError, ValueError):   # no 'google' package at all, or a broken one
+    except (ImportError, ValueError):  # no 'google' package at all, or a broken one
         return False
 
 

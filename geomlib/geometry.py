@@ -11,8 +11,18 @@ import numpy as np
 from .topology import edges
 from .validate import as_faces, as_mesh, as_vertices
 
-__all__ = ["corner_positions", "cross", "face_cross", "face_areas", "face_normals", "vertex_normals", "surface_area", "enclosed_volume",
-           "bounding_box_diagonal", "mean_edge_length"]
+__all__ = [
+    "corner_positions",
+    "cross",
+    "face_cross",
+    "face_areas",
+    "face_normals",
+    "vertex_normals",
+    "surface_area",
+    "enclosed_volume",
+    "bounding_box_diagonal",
+    "mean_edge_length",
+]
 
 
 def corner_positions(V, F):

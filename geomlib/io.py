@@ -76,10 +76,41 @@ SUPPORTED_EXTENSIONS = (".obj", ".off", ".ply", ".stl")
 
 # statements of the OBJ format that carry nothing for a triangle mesh
 _OBJ_IGNORED = {
-    b"vn", b"vt", b"vp", b"o", b"g", b"s", b"usemtl", b"mtllib", b"l", b"p", b"mg",
-    b"cstype", b"deg", b"bmat", b"step", b"curv", b"curv2", b"surf", b"parm", b"trim", b"hole",
-    b"scrv", b"sp", b"end", b"con", b"bevel", b"c_interp", b"d_interp", b"lod", b"maplib",
-    b"usemap", b"shadow_obj", b"trace_obj", b"ctech", b"stech",
+    b"vn",
+    b"vt",
+    b"vp",
+    b"o",
+    b"g",
+    b"s",
+    b"usemtl",
+    b"mtllib",
+    b"l",
+    b"p",
+    b"mg",
+    b"cstype",
+    b"deg",
+    b"bmat",
+    b"step",
+    b"curv",
+    b"curv2",
+    b"surf",
+    b"parm",
+    b"trim",
+    b"hole",
+    b"scrv",
+    b"sp",
+    b"end",
+    b"con",
+    b"bevel",
+    b"c_interp",
+    b"d_interp",
+    b"lod",
+    b"maplib",
+    b"usemap",
+    b"shadow_obj",
+    b"trace_obj",
+    b"ctech",
+    b"stech",
 }
 
 
@@ -118,31 +149,31 @@ def _line_bounds(data):
 def _obj_lines(data):
     """The file as newline-terminated statements, line k of the result being line k + 1 of the file."""
     if data.startswith(_BOM):  # written by many Windows programs
-        data = data[len(_BOM):]
+        data = data[len(_BOM) :]
     if b"\r" in data:  # CRLF (Windows) or CR (classic Mac OS) line ends
         data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     if not data.endswith(b"\n"):
         data += b"\n"
     arr = np.frombuffer(data, np.uint8)
     starts, ends = _line_bounds(data)
-    special = np.isin(arr[starts], (32, 9))                                  # leading blanks
-    special[np.searchsorted(ends, np.flatnonzero(arr == ord("#")))] = True      # a comment ...
-    special &= arr[starts] != ord("#")                                          # ... after a statement
+    special = np.isin(arr[starts], (32, 9))  # leading blanks
+    special[np.searchsorted(ends, np.flatnonzero(arr == ord("#")))] = True  # a comment ...
+    special &= arr[starts] != ord("#")  # ... after a statement
     special |= (ends > starts) & (arr[np.maximum(ends - 1, 0)] == ord("\\"))  # a continuation
     if not special.any():
         return data
-    text = {k: data[starts[k]:ends[k]].split(b"#", 1)[0].strip() for k in np.flatnonzero(special).tolist()}
+    text = {k: data[starts[k] : ends[k]].split(b"#", 1)[0].strip() for k in np.flatnonzero(special).tolist()}
     # a trailing backslash (outside a comment) continues the statement on the next line: the
     # joined statement keeps the number of its first line, and the continued line becomes blank
     for k in sorted(text):
         while text[k].endswith(b"\\") and k + 1 < len(starts):
-            following = text.get(k + 1, data[starts[k + 1]:ends[k + 1]])
+            following = text.get(k + 1, data[starts[k + 1] : ends[k + 1]])
             text[k] = text[k][:-1] + b" " + following.split(b"#", 1)[0].strip()
             text[k + 1] = b""
         text[k] = text[k].rstrip(b"\\")
     pieces, pos = [], 0
     for k in sorted(text):
-        pieces += [data[pos:starts[k]], text[k]]
+        pieces += [data[pos : starts[k]], text[k]]
         pos = ends[k]
     return b"".join(pieces) + data[pos:]
 
@@ -155,14 +186,22 @@ def _obj_statements(data, starts, ends, where):
     ws1 = (c1 == 32) | (c1 == 9)
     ws2 = (c2 == 32) | (c2 == 9)
     is_v, is_f, is_l = ((c0 == ord(c)) & ws1 for c in "vfl")
-    known = (is_v | is_f | is_l | (starts == ends) | (c0 == ord("#"))
-             | ((c0 == ord("v")) & np.isin(c1, np.frombuffer(b"ntp", np.uint8)) & ws2)
-             | (np.isin(c0, np.frombuffer(b"ogsp", np.uint8)) & (ws1 | (starts + 1 == ends))))
+    known = (
+        is_v
+        | is_f
+        | is_l
+        | (starts == ends)
+        | (c0 == ord("#"))
+        | ((c0 == ord("v")) & np.isin(c1, np.frombuffer(b"ntp", np.uint8)) & ws2)
+        | (np.isin(c0, np.frombuffer(b"ogsp", np.uint8)) & (ws1 | (starts + 1 == ends)))
+    )
     for k in np.flatnonzero(~known).tolist():  # longer keywords (usemtl, mtllib, ...) or an error
-        words = data[starts[k]:ends[k]].split()
+        words = data[starts[k] : ends[k]].split()
         if words and words[0] not in _OBJ_IGNORED:
-            raise MeshError(f"{where}: line {k + 1}: not an OBJ statement (expected v, f, vn, vt, o, g, s, "
-                            f"usemtl, mtllib or a # comment): {_show(data[starts[k]:ends[k]])}")
+            raise MeshError(
+                f"{where}: line {k + 1}: not an OBJ statement (expected v, f, vn, vt, o, g, s, "
+                f"usemtl, mtllib or a # comment): {_show(data[starts[k] : ends[k]])}"
+            )
     return is_v, is_f, is_l
 
 
@@ -177,7 +216,7 @@ def _select(data, starts, ends, idx, keyword):
     breaks = np.flatnonzero(np.diff(idx) != 1)
     if len(breaks) < 64:  # a few runs of consecutive lines (all v, then all f): plain slices
         first, last = np.r_[idx[0], idx[breaks + 1]], np.r_[idx[breaks], idx[-1]]
-        buf = b"".join(data[a:b + 1] for a, b in zip(starts[first].tolist(), ends[last].tolist()))
+        buf = b"".join(data[a : b + 1] for a, b in zip(starts[first].tolist(), ends[last].tolist()))
     else:  # interleaved lines (v and vn alternating): a mask of the bytes to keep
         arr = np.frombuffer(data, np.uint8)
         keep = np.zeros(len(arr) + 1, np.int8)
@@ -210,12 +249,14 @@ def _numbers(buf, dtype):
 def _obj_bad_line(data, starts, ends, idx, where):
     """Raise the MeshError naming the first malformed v or f line among ``idx`` (the error path only)."""
     for k in idx.tolist():
-        raw = data[starts[k]:ends[k]]
+        raw = data[starts[k] : ends[k]]
         words = raw.split()
         if words[0] == b"v":
             if len(words) - 1 not in (3, 4, 6, 7):
-                raise MeshError(f"{where}: line {k + 1}: a vertex needs x y z (optionally w or r g b), "
-                                f"found {len(words) - 1} numbers: {_show(raw)}")
+                raise MeshError(
+                    f"{where}: line {k + 1}: a vertex needs x y z (optionally w or r g b), "
+                    f"found {len(words) - 1} numbers: {_show(raw)}"
+                )
             try:
                 [float(w) for w in words[1:]]
             except ValueError:
@@ -224,8 +265,9 @@ def _obj_bad_line(data, starts, ends, idx, where):
             try:
                 corners = [int(c.split(b"/")[0]) for c in words[1:]]
             except ValueError:
-                raise MeshError(f"{where}: line {k + 1}: face corners must be integers "
-                                f"(v, v/vt, v//vn or v/vt/vn): {_show(raw)}") from None
+                raise MeshError(
+                    f"{where}: line {k + 1}: face corners must be integers (v, v/vt, v//vn or v/vt/vn): {_show(raw)}"
+                ) from None
             if any(abs(c) > _HUGE for c in corners):
                 raise MeshError(f"{where}: line {k + 1}: face index too large: {_show(raw)}")
     raise MeshError(f"{where}: cannot read the numbers of the v and f lines")  # not reached for valid bytes
@@ -277,7 +319,11 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
     small = np.flatnonzero(sizes < 3)
     if len(small):
         p = small[0]
-        more = f" (and {count_text(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})" if len(small) > 1 else ""
+        more = (
+            f" (and {count_text(small[1:], 'more such face')} on lines {format_indices(lines[small[1:]])})"
+            if len(small) > 1
+            else ""
+        )
         raise MeshError(f"{where}: line {lines[p]}: a face needs at least 3 vertex indices, found {sizes[p]}{more}")
     ntri = sizes - 2
     first_tri = np.cumsum(ntri) - ntri  # row in F of each polygon's first triangle
@@ -300,9 +346,7 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
     if bad.any():
         corners = np.flatnonzero(bad)
         bad_polys = np.unique(poly[corners])
-        detail = "; ".join(
-            f"line {lines[poly[c]]} (face {first_tri[poly[c]]}): index {idx[c]}" for c in corners[:5]
-        )
+        detail = "; ".join(f"line {lines[poly[c]]} (face {first_tri[poly[c]]}): index {idx[c]}" for c in corners[:5])
         if len(corners) > 5:
             detail += f" (and {len(corners) - 5} more)"
         valid = f"1..{n}, or -1..-{n} counting back" if one_based else f"0..{n - 1}"
@@ -324,8 +368,7 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
         rows = np.flatnonzero(rep)
         plines = lines[rows if tri_poly is None else tri_poly[rows]]
         detail = "; ".join(f"line {L}: face {r} = {F[r].tolist()}" for r, L in zip(rows[:5], plines[:5]))
-        tail = (f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}"
-                if len(rows) > 1 else "")
+        tail = f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}" if len(rows) > 1 else ""
         raise MeshError(
             f"{where}: {count_text(rows, 'face repeats', 'faces repeat')} a vertex (no triangle; 0-based vertex "
             f"indices): {detail}{tail}"
@@ -387,11 +430,12 @@ def _read_off(data, where):
         if nv < 0 or nf < 0:
             raise ValueError
     except (ValueError, IndexError):
-        raise MeshError(f"{where}: line {lineno}: expected the counts 'nv nf ne' of the OFF header, "
-                        f"found {_show(b' '.join(words))}") from None
+        raise MeshError(
+            f"{where}: line {lineno}: expected the counts 'nv nf ne' of the OFF header, found {_show(b' '.join(words))}"
+        ) from None
     pos += 1
-    vlines = content[pos:pos + nv]
-    flines = content[pos + nv:pos + nv + nf]
+    vlines = content[pos : pos + nv]
+    flines = content[pos + nv : pos + nv + nf]
     if len(vlines) < nv or len(flines) < nf:
         raise MeshError(
             f"{where}: the header (line {lineno}) announces {nv} vertices and {nf} faces, but the file ends "
@@ -405,26 +449,30 @@ def _read_off(data, where):
                 raise ValueError
             V[k] = [float(x) for x in w[:3]]
         except ValueError:
-            raise MeshError(f"{where}: line {ln}: a vertex needs 3 numbers x y z, found {_show(b' '.join(w))}") from None
+            raise MeshError(
+                f"{where}: line {ln}: a vertex needs 3 numbers x y z, found {_show(b' '.join(w))}"
+            ) from None
     idx, sizes, lines = [], [], []
     for ln, w in flines:
         try:
             k = int(w[0])
             if k < 0 or len(w) < 1 + k:
                 raise ValueError
-            face = [int(x) for x in w[1:1 + k]]
+            face = [int(x) for x in w[1 : 1 + k]]
             if any(abs(c) > _HUGE for c in face):
                 raise ValueError
             idx.extend(face)
         except ValueError:
-            raise MeshError(f"{where}: line {ln}: a face is 'k i0 ... ik-1' with k integer indices, "
-                            f"found {_show(b' '.join(w))}") from None
+            raise MeshError(
+                f"{where}: line {ln}: a face is 'k i0 ... ik-1' with k integer indices, found {_show(b' '.join(w))}"
+            ) from None
         sizes.append(k)
         lines.append(ln)
     vline_numbers = np.asarray([ln for ln, _ in vlines])
     V = _check_vertices(V, where, lines_of=vline_numbers)
-    F = _build_faces(where, nv, np.asarray(idx, np.int64), np.asarray(sizes, np.int64),
-                     np.asarray(lines, np.int64), one_based=False)
+    F = _build_faces(
+        where, nv, np.asarray(idx, np.int64), np.asarray(sizes, np.int64), np.asarray(lines, np.int64), one_based=False
+    )
     return V, F
 
 

@@ -38,8 +38,19 @@ from .geometry import corner_positions, cross
 from .topology import edges
 from .validate import as_mesh, is_zero_area
 
-__all__ = ["laplacian", "uniform_laplacian", "cotangent_matrix", "cotangent_weights", "vertex_areas",
-           "barycentric_areas", "mixed_areas", "face_geometry", "uniform_adjacency", "WEIGHTS", "AREAS"]
+__all__ = [
+    "laplacian",
+    "uniform_laplacian",
+    "cotangent_matrix",
+    "cotangent_weights",
+    "vertex_areas",
+    "barycentric_areas",
+    "mixed_areas",
+    "face_geometry",
+    "uniform_adjacency",
+    "WEIGHTS",
+    "AREAS",
+]
 
 WEIGHTS = ("cotan", "uniform")
 AREAS = ("barycentric", "mixed")
@@ -75,10 +86,10 @@ def face_geometry(V, F):
         Zero-area faces (:func:`geomlib.validate.is_zero_area`).
     """
     V, F = as_mesh(V, F)
-    v0, v1, v2 = corner_positions(V, F)            # (3, m) coordinate rows of each corner
-    e = (v2 - v1, v0 - v2, v1 - v0)                # e_i = v_k - v_j, the edge opposite corner i
-    l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])   # |e_i|^2, (3, m)
-    N2 = cross(e[1], e[2])                         # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
+    v0, v1, v2 = corner_positions(V, F)  # (3, m) coordinate rows of each corner
+    e = (v2 - v1, v0 - v2, v1 - v0)  # e_i = v_k - v_j, the edge opposite corner i
+    l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])  # |e_i|^2, (3, m)
+    N2 = cross(e[1], e[2])  # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
     dblA = np.sqrt(np.einsum("cf,cf->f", N2, N2))
     degenerate = is_zero_area(dblA, l2.max(axis=0))
     cot = (l2.sum(axis=0) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))
@@ -91,8 +102,12 @@ def warn_zero_area(degenerate):
     """One MeshWarning naming the zero-area faces, if there are any."""
     if degenerate.any():
         idx = np.flatnonzero(degenerate)
-        warnings.warn(f"{len(idx)} zero-area triangle(s) contribute nothing to the cotangent Laplacian "
-                      f"and the vertex areas: faces {format_indices(idx)}", MeshWarning, stacklevel=3)
+        warnings.warn(
+            f"{len(idx)} zero-area triangle(s) contribute nothing to the cotangent Laplacian "
+            f"and the vertex areas: faces {format_indices(idx)}",
+            MeshWarning,
+            stacklevel=3,
+        )
 
 
 def uniform_laplacian(V, F):
@@ -109,10 +124,11 @@ def uniform_laplacian(V, F):
     """
     V, F = as_mesh(V, F)
     n = len(V)
-    E = edges(F)                                           # each edge ij once, i < j
+    E = edges(F)  # each edge ij once, i < j
     ones = np.ones(len(E))
-    adjacency = sp.coo_matrix((np.r_[ones, ones], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])),
-                              shape=(n, n)).tocsr()
+    adjacency = sp.coo_matrix(
+        (np.r_[ones, ones], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])), shape=(n, n)
+    ).tocsr()
     valence = np.diff(adjacency.indptr).astype(np.float64)
     C = (adjacency - sp.diags(valence)).tocsr()
     C.sort_indices()
@@ -133,7 +149,7 @@ def cotangent_matrix(V, F):
     warn_zero_area(degenerate)
     index = np.int32 if n < 2**31 - 1 else np.int64
     j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
-    w = 0.5 * cot.T.ravel()                                                        # gets 1/2 cot theta_i
+    w = 0.5 * cot.T.ravel()  # gets 1/2 cot theta_i
     diagonal = -(np.bincount(j, w, minlength=n) + np.bincount(k, w, minlength=n))  # rows sum to zero
     d = np.arange(n, dtype=index)
     rows, cols = np.concatenate([j, k, d]), np.concatenate([k, j, d])
@@ -171,7 +187,7 @@ def mixed_areas(V, F):
     A = 0.5 * dblA[:, None]
     lc = l2 * cot
     voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
-    obtuse = cot < 0                                    # cot theta < 0 <=> theta > pi/2
+    obtuse = cot < 0  # cot theta < 0 <=> theta > pi/2
     obtuse_triangle = obtuse.any(axis=1, keepdims=True)
     per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
     per_corner[degenerate] = 0.0
@@ -226,7 +242,7 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     V, F = as_mesh(V, F)
     if weights == "uniform":
         return uniform_laplacian(V, F)
-    C = cotangent_matrix(V, F)                      # names the zero-area faces, if any
+    C = cotangent_matrix(V, F)  # names the zero-area faces, if any
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshWarning)  # the same faces: named once is enough
         M = sp.diags(vertex_areas(V, F, area))

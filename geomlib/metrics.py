@@ -34,11 +34,29 @@ from .geometry import bounding_box_diagonal, enclosed_volume, face_cross, mean_e
 from .topology import Topology
 from .validate import as_faces, as_vertices
 
-__all__ = ["SHARP_ANGLE", "HAUSDORFF_SAMPLES_PER_FACE", "vertex_rms", "hausdorff_distance", "face_normal_angles",
-           "normal_angle_error", "area_change", "volume_change", "dihedral_angles", "sharp_edges",
-           "sharp_edge_error", "denoising_metrics", "MeshComparison", "interior_edges", "point_triangle_distance",
-           "point_surface_distance", "sample_surface", "bounding_box_diagonal", "surface_area",
-           "enclosed_volume", "mean_edge_length"]
+__all__ = [
+    "SHARP_ANGLE",
+    "HAUSDORFF_SAMPLES_PER_FACE",
+    "vertex_rms",
+    "hausdorff_distance",
+    "face_normal_angles",
+    "normal_angle_error",
+    "area_change",
+    "volume_change",
+    "dihedral_angles",
+    "sharp_edges",
+    "sharp_edge_error",
+    "denoising_metrics",
+    "MeshComparison",
+    "interior_edges",
+    "point_triangle_distance",
+    "point_surface_distance",
+    "sample_surface",
+    "bounding_box_diagonal",
+    "surface_area",
+    "enclosed_volume",
+    "mean_edge_length",
+]
 
 #: Default threshold (degrees) on the clean mesh's dihedral (bend) angle above
 #: which an edge counts as a sharp feature edge.
@@ -53,10 +71,12 @@ HAUSDORFF_SAMPLES_PER_FACE = 2.0
 # checks
 # ----------------------------------------------------------------------------
 
+
 def _same_shape(V, V_clean):
     if V.shape != V_clean.shape:
-        raise MeshError(f"V and V_clean must have the same shape (same connectivity), "
-                        f"got {V.shape} and {V_clean.shape}")
+        raise MeshError(
+            f"V and V_clean must have the same shape (same connectivity), got {V.shape} and {V_clean.shape}"
+        )
 
 
 def interior_edges(F):
@@ -118,12 +138,14 @@ def dihedral_angles(V, F, edges=None):
 def _bend_angles(V, F, E, f1, f2, N=None):
     N = face_cross(V, F) if N is None else N
     n1, n2 = N[f1], N[f2]
-    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1),
-                                  np.einsum("ij,ij->i", n1, n2)))
+    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), np.einsum("ij,ij->i", n1, n2)))
     # far vertex of f2: the corner that is neither end of the edge
     G = F[f2]
-    far = np.where((G[:, 0] != E[:, 0]) & (G[:, 0] != E[:, 1]), G[:, 0],
-                   np.where((G[:, 1] != E[:, 0]) & (G[:, 1] != E[:, 1]), G[:, 1], G[:, 2]))
+    far = np.where(
+        (G[:, 0] != E[:, 0]) & (G[:, 0] != E[:, 1]),
+        G[:, 0],
+        np.where((G[:, 1] != E[:, 0]) & (G[:, 1] != E[:, 1]), G[:, 1], G[:, 2]),
+    )
     height = np.einsum("ij,ij->i", n1, V[far] - V[E[:, 0]])
     return np.where(height > 0, -angle, angle)
 
@@ -131,6 +153,7 @@ def _bend_angles(V, F, E, f1, f2, N=None):
 # ----------------------------------------------------------------------------
 # exact point-to-surface distance
 # ----------------------------------------------------------------------------
+
 
 def _segment_distance2(P, A, B):
     AB = B - A
@@ -157,14 +180,15 @@ def point_triangle_distance(P, A, B, C):
         inside the triangle, otherwise the distance to the nearest of its
         three edges. Degenerate triangles reduce to segments or points.
     """
-    d2 = np.minimum(np.minimum(_segment_distance2(P, A, B), _segment_distance2(P, B, C)),
-                    _segment_distance2(P, C, A))
+    d2 = np.minimum(np.minimum(_segment_distance2(P, A, B), _segment_distance2(P, B, C)), _segment_distance2(P, C, A))
     N = np.cross(B - A, C - A)
     N2 = np.einsum("ij,ij->i", N, N)
-    inside = ((np.einsum("ij,ij->i", N, np.cross(B - A, P - A)) >= 0)
-              & (np.einsum("ij,ij->i", N, np.cross(C - B, P - B)) >= 0)
-              & (np.einsum("ij,ij->i", N, np.cross(A - C, P - C)) >= 0)
-              & (N2 > 0))
+    inside = (
+        (np.einsum("ij,ij->i", N, np.cross(B - A, P - A)) >= 0)
+        & (np.einsum("ij,ij->i", N, np.cross(C - B, P - B)) >= 0)
+        & (np.einsum("ij,ij->i", N, np.cross(A - C, P - C)) >= 0)
+        & (N2 > 0)
+    )
     h = np.einsum("ij,ij->i", N[inside], P[inside] - A[inside])
     d2[inside] = np.minimum(d2[inside], h * h / N2[inside])
     return np.sqrt(d2)
@@ -177,8 +201,9 @@ class _SurfaceIndex:
         self.V, self.F = V, F
         self.A, self.B, self.C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
         centroid = (self.A + self.B + self.C) / 3.0
-        self.radius = np.sqrt(np.max([np.einsum("ij,ij->i", X - centroid, X - centroid)
-                                      for X in (self.A, self.B, self.C)], axis=0))
+        self.radius = np.sqrt(
+            np.max([np.einsum("ij,ij->i", X - centroid, X - centroid) for X in (self.A, self.B, self.C)], axis=0)
+        )
         self.R = float(self.radius.max())
         self.centroid = centroid
         self.tree = cKDTree(centroid)
@@ -224,7 +249,7 @@ class _SurfaceIndex:
         best = 0.0
         batch = max(64, len(P) // 64)
         for start in range(0, len(P), batch):
-            chunk = order[start:start + batch]
+            chunk = order[start : start + batch]
             chunk = chunk[u[chunk] > best]
             if len(chunk) == 0:
                 break
@@ -290,6 +315,7 @@ def _sample(V, F, count, rng):
 # the comparison against one clean mesh
 # ----------------------------------------------------------------------------
 
+
 class MeshComparison:
     """One clean mesh ``(V_clean, F)`` to compare meshes of the same connectivity against.
 
@@ -324,8 +350,7 @@ class MeshComparison:
         Indices (into ``edges``) of the sharp edges.
     """
 
-    def __init__(self, V_clean, F, sharp_angle=SHARP_ANGLE,
-                 samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
+    def __init__(self, V_clean, F, sharp_angle=SHARP_ANGLE, samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
         self.V_clean = as_vertices(V_clean, where="V_clean").copy()
         self.F = as_faces(F, len(self.V_clean))
         self.diagonal = bounding_box_diagonal(self.V_clean)
@@ -362,8 +387,14 @@ class MeshComparison:
 
     def hausdorff(self, V, relative=True, seed=None):
         """:func:`hausdorff_distance` to the clean surface, with this comparison's density and seed."""
-        return hausdorff_distance(self._check(V), self.V_clean, self.F, relative=relative,
-                                  samples_per_face=self.samples_per_face, seed=self.seed if seed is None else seed)
+        return hausdorff_distance(
+            self._check(V),
+            self.V_clean,
+            self.F,
+            relative=relative,
+            samples_per_face=self.samples_per_face,
+            seed=self.seed if seed is None else seed,
+        )
 
     def area_change(self, V):
         """:func:`area_change`: ``(A - A_clean) / A_clean``."""
@@ -424,8 +455,7 @@ def vertex_rms(V, V_clean, relative=True):
     return rms / bounding_box_diagonal(V_clean) if relative else rms
 
 
-def hausdorff_distance(V, V_clean, F, F_clean=None, relative=True,
-                       samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
+def hausdorff_distance(V, V_clean, F, F_clean=None, relative=True, samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
     """Symmetric Hausdorff distance between two triangle surfaces, estimated from below.
 
     ``max(sup_{p on S} d(p, S_clean), sup_{q on S_clean} d(q, S))`` where
@@ -517,9 +547,10 @@ def volume_change(V, V_clean, F, edges=None):
     _, _, _, boundary, other = interior_edges(F) if edges is None else edges
     if len(boundary) or len(other):
         bad = np.vstack([boundary, other])
-        raise MeshError("the volume change is defined for closed meshes only; "
-                        f"{len(bad)} edge(s) are boundary or non-manifold, e.g. "
-                        + ", ".join(f"({i}, {j})" for i, j in bad[:5]))
+        raise MeshError(
+            "the volume change is defined for closed meshes only; "
+            f"{len(bad)} edge(s) are boundary or non-manifold, e.g. " + ", ".join(f"({i}, {j})" for i, j in bad[:5])
+        )
     vol_clean = enclosed_volume(V_clean, F)
     if vol_clean == 0:
         raise MeshError("the clean mesh encloses zero volume")
@@ -561,7 +592,6 @@ def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE, edges=None):
     return float(np.mean(np.abs(bend - bend_clean[sharp])))
 
 
-def denoising_metrics(V, V_clean, F, sharp_angle=SHARP_ANGLE,
-                      samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
+def denoising_metrics(V, V_clean, F, sharp_angle=SHARP_ANGLE, samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):
     """Every metric of V against the clean mesh, as a dict (see :meth:`MeshComparison.evaluate`)."""
     return MeshComparison(V_clean, F, sharp_angle, samples_per_face, seed).evaluate(V)

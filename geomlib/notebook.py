@@ -80,11 +80,14 @@ class _Source:
         from pygments.formatters import HtmlFormatter
         from pygments.lexers import PythonLexer
 
-        formatter = HtmlFormatter(noclasses=True, style="default", linenos="inline",
-                                  linenostart=self.first, nobackground=True)
+        formatter = HtmlFormatter(
+            noclasses=True, style="default", linenos="inline", linenostart=self.first, nobackground=True
+        )
         body = highlight(self.code, PythonLexer(), formatter)
-        return (f'<div class="geomlib-source"><div style="font-family:monospace;font-size:90%;'
-                f'color:#555">{html.escape(self.heading)}</div>{body}</div>')
+        return (
+            f'<div class="geomlib-source"><div style="font-family:monospace;font-size:90%;'
+            f'color:#555">{html.escape(self.heading)}</div>{body}</div>'
+        )
 
     def __repr__(self):
         return f"# {self.heading}\n{self.code}"

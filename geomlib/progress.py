@@ -52,8 +52,7 @@ class Stages:
         if self.estimate > SECONDS:
             from tqdm.auto import tqdm
 
-            self.bar = tqdm(total=len(self.names), desc=f"{self.desc} (about {self.estimate:.0f} s)",
-                            leave=False)
+            self.bar = tqdm(total=len(self.names), desc=f"{self.desc} (about {self.estimate:.0f} s)", leave=False)
             self.bar.set_postfix_str(self.names[0])
         return self
 

@@ -93,22 +93,30 @@ def prepare(V, F, *, one_component=False, closed=False, what="this notebook"):
     zero = zero_area_faces(V, F)
     if len(zero):
         V, F, _ = remove_zero_area_faces(V, F)
-        note(f"The mesh has {len(zero)} zero-area faces; their angles are undefined, so {what} leaves them "
-             "out (`geomlib.repair.remove_zero_area_faces(V, F)`).")
+        note(
+            f"The mesh has {len(zero)} zero-area faces; their angles are undefined, so {what} leaves them "
+            "out (`geomlib.repair.remove_zero_area_faces(V, F)`)."
+        )
     unused = len(V) - len(np.unique(F))
     if unused:
         V, F, k = remove_unreferenced_vertices(V, F)
         kept = kept[k]
-        note(f"{unused} vertices are not used by any face (they have no area); {what} computes on the "
-             f"{len(V)} vertices the faces use (`geomlib.repair.remove_unreferenced_vertices(V, F)`).")
+        note(
+            f"{unused} vertices are not used by any face (they have no area); {what} computes on the "
+            f"{len(V)} vertices the faces use (`geomlib.repair.remove_unreferenced_vertices(V, F)`)."
+        )
     count = connected_components(F, len(V)).max() + 1
     if one_component and count > 1:
         n_before = len(V)
         V, F, k = largest_component(V, F)
         kept = kept[k]
-        note(f"The mesh has {count} connected components; {what} needs one, so it keeps the largest "
-             f"({len(V)} of {n_before} vertices; `geomlib.repair.largest_component(V, F)`).")
+        note(
+            f"The mesh has {count} connected components; {what} needs one, so it keeps the largest "
+            f"({len(V)} of {n_before} vertices; `geomlib.repair.largest_component(V, F)`)."
+        )
     if closed and len(boundary_vertices(F, len(V))):
-        note(f"The mesh is open ({len(boundary_vertices(F, len(V)))} boundary vertices); {what} assumes a "
-             "closed surface, so boundary vertices are held fixed and volumes are not meaningful.")
+        note(
+            f"The mesh is open ({len(boundary_vertices(F, len(V)))} boundary vertices); {what} assumes a "
+            "closed surface, so boundary vertices are held fixed and volumes are not meaningful."
+        )
     return V, F, kept

@@ -20,6 +20,7 @@ from .validate import as_mesh, zero_area_faces
 
 __all__ = ["check_mesh", "MeshReport"]
 
+
 @dataclass(repr=False)
 class MeshReport:
     """Properties of a mesh that results depend on; returned by :func:`check_mesh`.
@@ -95,11 +96,17 @@ class MeshReport:
             ("edges", f"{self.n_edges}"),
             ("Euler characteristic V - E + F", f"{self.euler_characteristic}"),
             ("genus", "n/a (needs a connected, oriented manifold)" if self.genus is None else f"{self.genus}"),
-            ("connected components", f"{self.n_components}"
-             + (f" (faces per component: {format_indices(self.component_sizes)})" if self.n_components > 1 else "")),
+            (
+                "connected components",
+                f"{self.n_components}"
+                + (f" (faces per component: {format_indices(self.component_sizes)})" if self.n_components > 1 else ""),
+            ),
             ("closed", yes[self.is_closed]),
-            ("boundary", f"{count_text(self.boundary_edges, 'edge')} in {count_text(loops, 'loop')}"
-             + (f" of {format_indices(loops)} edges" if loops else "")),
+            (
+                "boundary",
+                f"{count_text(self.boundary_edges, 'edge')} in {count_text(loops, 'loop')}"
+                + (f" of {format_indices(loops)} edges" if loops else ""),
+            ),
             ("manifold", yes[self.is_manifold]),
             ("consistently oriented", yes[self.is_oriented]),
             ("zero-area faces", _listing(self.zero_area_faces)),
@@ -123,8 +130,10 @@ class MeshReport:
         return "\n".join(lines)
 
     def __repr__(self):
-        return (f"MeshReport(n_vertices={self.n_vertices}, n_faces={self.n_faces}, "
-                f"euler_characteristic={self.euler_characteristic}, problems={len(self.problems)})")
+        return (
+            f"MeshReport(n_vertices={self.n_vertices}, n_faces={self.n_faces}, "
+            f"euler_characteristic={self.euler_characteristic}, problems={len(self.problems)})"
+        )
 
     def _repr_html_(self):
         import html
@@ -215,38 +224,46 @@ def check_mesh(V, F):
     if len(zero):
         problems.append(
             f"{count_text(zero, 'zero-area face')} ({format_indices(zero)}): their cotangent weights and normals are "
-            "undefined; the uniform Laplacian, valence and topology still work")
+            "undefined; the uniform Laplacian, valence and topology still work"
+        )
     if len(nm_edges):
         problems.append(
             f"{count_text(nm_edges, 'non-manifold edge')} used by more than two faces ({_edges_text(nm_edges)}): "
-            "Laplacians still assemble, but one_ring fails at their vertices and boundary loops can be ambiguous")
+            "Laplacians still assemble, but one_ring fails at their vertices and boundary loops can be ambiguous"
+        )
     if len(nm_vertices):
         problems.append(
             f"{count_text(nm_vertices, 'non-manifold vertex', 'non-manifold vertices')} whose faces form more than one fan ({format_indices(nm_vertices)}): "
             "Laplacians and curvature still compute, but one_ring fails there and the angle deficit "
-            "mixes the fans; Euler characteristic and genus do not describe a surface")
+            "mixes the fans; Euler characteristic and genus do not describe a surface"
+        )
     if len(inconsistent):
         problems.append(
             f"{count_text(inconsistent, 'edge')} traversed in the same direction by both faces (inconsistent orientation, "
             f"{_edges_text(inconsistent)}): signed mean curvature and normals flip "
-            "between the two sides; unsigned H, K and the Laplacians still work")
+            "between the two sides; unsigned H, K and the Laplacians still work"
+        )
     if n_comp > 1:
         problems.append(
             f"{n_comp} connected components: the Laplacian has one zero eigenvalue per component; "
-            "curvature and smoothing work per component")
+            "curvature and smoothing work per component"
+        )
     if len(unref):
         problems.append(
             f"{count_text(unref, 'unreferenced vertex', 'unreferenced vertices')} ({format_indices(unref)}): no area and no neighbours, "
-            "so their Laplacian rows are zero and M is singular there; they are kept so that indices match the file")
+            "so their Laplacian rows are zero and M is singular there; they are kept so that indices match the file"
+        )
     if len(dups):
         problems.append(
-            f"{count_text(dups, 'duplicate face')} ({format_indices(dups)}): areas and cotangent weights count them twice")
+            f"{count_text(dups, 'duplicate face')} ({format_indices(dups)}): areas and cotangent weights count them twice"
+        )
     notes = []
     if len(bedges):
         notes.append(
             f"open surface, {count_text(bedges, 'boundary edge')} in {count_text(loops, 'loop')}: every geomlib function "
             "works; each curvature function states its rule at boundary vertices, and Gauss-Bonnet needs the "
-            "boundary (geodesic curvature) term")
+            "boundary (geodesic curvature) term"
+        )
     return MeshReport(
         n_vertices=n,
         n_faces=m,

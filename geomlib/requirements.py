@@ -22,18 +22,26 @@ def positive_vertex_areas(M, F, what):
     if len(bad) == 0:
         return m
     if F is None:  # only M is known: the two cases cannot be told apart
-        raise MeshError(f"{what}: the vertex area M_ii is zero at {len(bad)} of {len(m)} vertices "
-                        f"({format_indices(bad)}), so M^-1 does not exist there; vertices used by no "
-                        f"face are removed by V, F = geomlib.repair.remove_unreferenced_vertices(V, F)")
+        raise MeshError(
+            f"{what}: the vertex area M_ii is zero at {len(bad)} of {len(m)} vertices "
+            f"({format_indices(bad)}), so M^-1 does not exist there; vertices used by no "
+            f"face are removed by V, F = geomlib.repair.remove_unreferenced_vertices(V, F)"
+        )
     used = np.zeros(len(m), dtype=bool)
     used[np.asarray(F).ravel()] = True
     unused, degenerate = bad[~used[bad]], bad[used[bad]]
     parts = []
     if len(unused):
-        parts.append(f"{len(unused)} vertices are used by no face ({format_indices(unused)}); "
-                     f"remove them with V, F = geomlib.repair.remove_unreferenced_vertices(V, F)")
+        parts.append(
+            f"{len(unused)} vertices are used by no face ({format_indices(unused)}); "
+            f"remove them with V, F = geomlib.repair.remove_unreferenced_vertices(V, F)"
+        )
     if len(degenerate):
-        parts.append(f"{len(degenerate)} vertices are used only by zero-area faces "
-                     f"({format_indices(degenerate)}); geomlib.check_mesh(V, F) lists those faces")
-    raise MeshError(f"{what}: the vertex area M_ii is zero at {len(bad)} of {len(m)} vertices, so "
-                    f"M^-1 does not exist there: " + "; ".join(parts))
+        parts.append(
+            f"{len(degenerate)} vertices are used only by zero-area faces "
+            f"({format_indices(degenerate)}); geomlib.check_mesh(V, F) lists those faces"
+        )
+    raise MeshError(
+        f"{what}: the vertex area M_ii is zero at {len(bad)} of {len(m)} vertices, so "
+        f"M^-1 does not exist there: " + "; ".join(parts)
+    )

@@ -49,8 +49,13 @@ from .topology import boundary_vertices
 from .validate import as_mesh
 
 __all__ = [
-    "explicit_step", "implicit_step", "explicit_smoothing", "implicit_smoothing",
-    "explicit_step_limit", "highest_frequency_mode", "ImplicitSmoother",
+    "explicit_step",
+    "implicit_step",
+    "explicit_smoothing",
+    "implicit_smoothing",
+    "explicit_step_limit",
+    "highest_frequency_mode",
+    "ImplicitSmoother",
 ]
 
 #: Explicit smoothing stops (see ``on_failure``) when a coordinate moves further
@@ -68,6 +73,7 @@ _ON_FAILURE = ("raise", "stop")
 
 # --------------------------------------------------------------------------
 # the formulas
+
 
 def explicit_step(P, M, C, tau):
     """One explicit (forward Euler) step of the heat flow: ``P' = P + tau M^-1 C P``.
@@ -155,7 +161,7 @@ def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="
         I, m, S = _moving_block(V, F, weights, area, boundary, "highest_frequency_mode")
         lam_max, y = largest_eigenpair(S) if len(I) else (0.0, np.zeros(0))
         e = np.zeros(len(V))
-        e[I] = y / np.sqrt(m[I])                              # e = M^-1/2 y, e^T M e = 1
+        e[I] = y / np.sqrt(m[I])  # e = M^-1/2 y, e^T M e = 1
         if len(I) and e[np.argmax(np.abs(e))] < 0:
             e = -e
         _remember(name, (lam_max, e))
@@ -177,12 +183,13 @@ def _moving_block(V, F, weights, area, boundary, what):
     M, C = laplacian(V, F, weights=weights, area=area)
     m = positive_vertex_areas(M, F, what)
     I = np.flatnonzero(_moving(F, len(V), boundary))
-    D_inv = sp.diags(1.0 / np.sqrt(m[I]))                     # M^-1/2 on the moving vertices
+    D_inv = sp.diags(1.0 / np.sqrt(m[I]))  # M^-1/2 on the moving vertices
     return I, m, (D_inv @ (-C.tocsr()[I][:, I]) @ D_inv).tocsr()
 
 
 # --------------------------------------------------------------------------
 # argument checks and shared pieces
+
 
 def _check_step(step, name="step"):
     if isinstance(step, (bool, np.bool_)) or not isinstance(step, numbers.Real):
@@ -191,15 +198,15 @@ def _check_step(step, name="step"):
     if not np.isfinite(step):
         raise MeshError(f"{name} must be finite, not {step!r}")
     if step < 0:
-        raise MeshError(f"{name} must be >= 0 (a negative step runs the heat flow backwards "
-                        f"and is unstable), not {step!r}")
+        raise MeshError(
+            f"{name} must be >= 0 (a negative step runs the heat flow backwards and is unstable), not {step!r}"
+        )
     return step
 
 
 def _check_iterations(iterations):
     if isinstance(iterations, (bool, np.bool_)) or not isinstance(iterations, numbers.Integral):
-        raise MeshError(f"iterations must be a whole number, not {type(iterations).__name__} "
-                        f"{iterations!r}")
+        raise MeshError(f"iterations must be a whole number, not {type(iterations).__name__} {iterations!r}")
     if iterations < 0:
         raise MeshError(f"iterations must be >= 0, not {iterations}")
     return int(iterations)
@@ -225,8 +232,7 @@ def _fail(on_failure, message, k, P_last):
         err = MeshError(message + "; the last valid positions are in the error's .V")
         err.V, err.iteration = P_last, k - 1
         raise err
-    warnings.warn(message + f"; stopped and returned the positions after iteration {k - 1}",
-                  MeshWarning, stacklevel=3)
+    warnings.warn(message + f"; stopped and returned the positions after iteration {k - 1}", MeshWarning, stacklevel=3)
     return P_last
 
 
@@ -244,19 +250,35 @@ def _explicit_tau(V, F, M, C, step, step_fraction, weights, area, boundary, movi
     if tau > 0 and moving.any() and tau * np.max(2.0 * c / m) > 2.0:
         limit = explicit_step_limit(V, F, weights, area, boundary)
         if tau > limit * (1 + 1e-12):
-            warnings.warn(f"explicit step {tau:.6g} exceeds the stability limit {limit:.6g} "
-                          f"(= 2 / lambda_max, {weights} weights, boundary {boundary}): the "
-                          f"highest-frequency component grows by {abs(1 - 2 * tau / limit):.4g} "
-                          f"per iteration", MeshWarning, stacklevel=3)
+            warnings.warn(
+                f"explicit step {tau:.6g} exceeds the stability limit {limit:.6g} "
+                f"(= 2 / lambda_max, {weights} weights, boundary {boundary}): the "
+                f"highest-frequency component grows by {abs(1 - 2 * tau / limit):.4g} "
+                f"per iteration",
+                MeshWarning,
+                stacklevel=3,
+            )
     return tau
 
 
 # --------------------------------------------------------------------------
 # explicit smoothing
 
-def explicit_smoothing(V, F, step=None, iterations=1, weights="cotan", *, step_fraction=None,
-                       area="barycentric", boundary="fixed", progress=None, callback=None,
-                       on_failure="raise"):
+
+def explicit_smoothing(
+    V,
+    F,
+    step=None,
+    iterations=1,
+    weights="cotan",
+    *,
+    step_fraction=None,
+    area="barycentric",
+    boundary="fixed",
+    progress=None,
+    callback=None,
+    on_failure="raise",
+):
     """Explicit Laplacian smoothing: ``P <- P + tau M^-1 C P``, repeated ``iterations`` times.
 
     Forward Euler on the heat flow ``dP/dt = Delta P`` with ``Delta = M^-1 C``
@@ -308,8 +330,11 @@ def explicit_smoothing(V, F, step=None, iterations=1, weights="cotan", *, step_f
     """
     V, F = as_mesh(V, F)
     iterations = _check_iterations(iterations)
-    for value, name, choices in ((weights, "weights", _WEIGHTS), (boundary, "boundary", _BOUNDARY),
-                                 (on_failure, "on_failure", _ON_FAILURE)):
+    for value, name, choices in (
+        (weights, "weights", _WEIGHTS),
+        (boundary, "boundary", _BOUNDARY),
+        (on_failure, "on_failure", _ON_FAILURE),
+    ):
         _check_choice(value, name, choices)
     M, C = laplacian(V, F, weights=weights, area=area)
     m = positive_vertex_areas(M, F, "explicit_smoothing")
@@ -320,10 +345,15 @@ def explicit_smoothing(V, F, step=None, iterations=1, weights="cotan", *, step_f
     P, bar = V.copy(), Iterations(iterations, progress, "explicit smoothing")
     try:
         for k in range(1, iterations + 1):
-            P_next = P + tau_Minv_C @ P                             # P + tau M^-1 C P
+            P_next = P + tau_Minv_C @ P  # P + tau M^-1 C P
             if not np.isfinite(P_next).all() or np.abs(P_next - V).max() > far:
-                return _fail(on_failure, f"explicit smoothing diverged at iteration {k} (step "
-                             f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals", k, P)
+                return _fail(
+                    on_failure,
+                    f"explicit smoothing diverged at iteration {k} (step "
+                    f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals",
+                    k,
+                    P,
+                )
             P = P_next
             if callback is not None:
                 callback(k, P)
@@ -335,6 +365,7 @@ def explicit_smoothing(V, F, step=None, iterations=1, weights="cotan", *, step_f
 
 # --------------------------------------------------------------------------
 # implicit smoothing
+
 
 class ImplicitSmoother:
     """Implicit smoothing with the operator of V kept fixed: factorise once per step, solve many times.
@@ -361,8 +392,7 @@ class ImplicitSmoother:
         For how many settings to keep the iterates (0: none).
     """
 
-    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed", cache_size=16,
-                 history_size=4):
+    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed", cache_size=16, history_size=4):
         V, F = as_mesh(V, F)
         _check_choice(weights, "weights", _WEIGHTS)
         _check_choice(boundary, "boundary", _BOUNDARY)
@@ -388,8 +418,7 @@ class ImplicitSmoother:
                 try:
                     factor = factorise(A)
                 except np.linalg.LinAlgError as exc:
-                    raise MeshError(f"implicit smoothing: M - {step:.6g} C is not positive definite "
-                                    f"({exc})") from None
+                    raise MeshError(f"implicit smoothing: M - {step:.6g} C is not positive definite ({exc})") from None
             while len(self._factors) >= self.cache_size:
                 self._factors.pop(next(iter(self._factors)))
         self._factors[step] = factor  # most recently used last
@@ -487,13 +516,17 @@ class _VolumeKeeper:
     def __init__(self, P, F):
         b = boundary_vertices(F, len(P))
         if len(b):
-            raise MeshError("keep_volume needs a closed mesh (the enclosed volume of an open mesh "
-                            f"is undefined); boundary vertices: {format_indices(b)}")
+            raise MeshError(
+                "keep_volume needs a closed mesh (the enclosed volume of an open mesh "
+                f"is undefined); boundary vertices: {format_indices(b)}"
+            )
         self.F = F
         self.vol0, self.c0 = _volume_centroid(P, F)
         if not self.vol0 > 0:
-            raise MeshError(f"keep_volume: the enclosed volume is {self.vol0:.6g}, not positive "
-                            "(faces must be counter-clockwise seen from outside)")
+            raise MeshError(
+                f"keep_volume: the enclosed volume is {self.vol0:.6g}, not positive "
+                "(faces must be counter-clockwise seen from outside)"
+            )
 
     def __call__(self, P, k):
         vol, c = _volume_centroid(P, self.F)
@@ -512,8 +545,7 @@ def _cg_steps(smoother, step):
         rhs = smoother.m[I, None] * P[I] + step * smoother.CP_B
         P_next = smoother.V.copy()
         for j in range(P.shape[1]):
-            x, info = sla.cg(A, rhs[:, j], x0=P[I, j], rtol=1e-10, atol=0.0, M=jacobi,
-                             maxiter=20 * len(I) + 100)
+            x, info = sla.cg(A, rhs[:, j], x0=P[I, j], rtol=1e-10, atol=0.0, M=jacobi, maxiter=20 * len(I) + 100)
             if info != 0:
                 raise MeshError(f"implicit smoothing: CG did not converge (info {info}); use solver='lu'")
             P_next[I, j] = x
@@ -539,9 +571,22 @@ def _rebuilt_steps(F, weights, area, boundary, step):
     return advance
 
 
-def implicit_smoothing(V, F, step, iterations=1, weights="cotan", *, area="barycentric",
-                       boundary="fixed", rebuild=False, keep_volume=False, solver="lu",
-                       progress=None, callback=None, on_failure="raise"):
+def implicit_smoothing(
+    V,
+    F,
+    step,
+    iterations=1,
+    weights="cotan",
+    *,
+    area="barycentric",
+    boundary="fixed",
+    rebuild=False,
+    keep_volume=False,
+    solver="lu",
+    progress=None,
+    callback=None,
+    on_failure="raise",
+):
     """Implicit Laplacian smoothing: solve ``(M - tau C) P' = M P``, repeated.
 
     Backward Euler on ``dP/dt = Delta P``, ``Delta = M^-1 C`` (C symmetric
@@ -603,8 +648,12 @@ def implicit_smoothing(V, F, step, iterations=1, weights="cotan", *, area="baryc
     """
     V, F = as_mesh(V, F)
     step, iterations = _check_step(step), _check_iterations(iterations)
-    for value, name, choices in ((weights, "weights", _WEIGHTS), (boundary, "boundary", _BOUNDARY),
-                                 (solver, "solver", ("lu", "cg")), (on_failure, "on_failure", _ON_FAILURE)):
+    for value, name, choices in (
+        (weights, "weights", _WEIGHTS),
+        (boundary, "boundary", _BOUNDARY),
+        (solver, "solver", ("lu", "cg")),
+        (on_failure, "on_failure", _ON_FAILURE),
+    ):
         _check_choice(value, name, choices)
     keeper = _VolumeKeeper(V, F) if keep_volume else None
     if rebuild:
@@ -627,11 +676,15 @@ def implicit_smoothing(V, F, step, iterations=1, weights="cotan", *, area="baryc
             except _Collapse as exc:
                 return _fail(on_failure, f"implicit smoothing stopped: {exc}", k, P)
             if not np.isfinite(P_next).all():
-                return _fail(on_failure, f"implicit smoothing stopped: non-finite positions at "
-                             f"iteration {k}", k, P)
+                return _fail(on_failure, f"implicit smoothing stopped: non-finite positions at iteration {k}", k, P)
             if rebuild and surface_area(P_next, F) < COLLAPSE_AREA_FRACTION * area0:
-                return _fail(on_failure, f"implicit smoothing stopped: the mesh collapsed (area "
-                             f"below {COLLAPSE_AREA_FRACTION:g} of the start) at iteration {k}", k, P)
+                return _fail(
+                    on_failure,
+                    f"implicit smoothing stopped: the mesh collapsed (area "
+                    f"below {COLLAPSE_AREA_FRACTION:g} of the start) at iteration {k}",
+                    k,
+                    P,
+                )
             P = P_next
             if callback is not None:
                 callback(k, P)

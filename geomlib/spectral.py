@@ -53,8 +53,7 @@ __all__ = [
 _METHODS = {"auto": "auto", "dense": "dense", "sparse": "sparse", "arpack": "sparse"}
 
 
-def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None,
-               method="auto", tol=None):
+def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=None):
     """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
 
     ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
@@ -120,11 +119,11 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cach
     k, method = _check_k(k, len(V)), _check_method(method)
     M, C = laplacian(V, F, weights=weights, area=area)
     m = positive_vertex_areas(M, F, "eigenbasis")
-    D_inv = sp.diags(1.0 / np.sqrt(m))              # M^-1/2
-    S = D_inv @ (-C) @ D_inv                        # symmetric PSD: S y = lam y
-    shift = 1e-4 * 4.0 * np.pi / m.sum()            # far below lam_1 (Weyl: about 4 pi / area)
+    D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
+    S = D_inv @ (-C) @ D_inv  # symmetric PSD: S y = lam y
+    shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
     lam, Y = smallest_eigenpairs(S.tocsr(), k, shift, _METHODS[method], tol or 0.0)
-    E = D_inv @ Y                                   # e = M^-1/2 y, so E^T M E = Y^T Y = I
+    E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
     return _tidy(lam, E, m, F)
 
 
@@ -135,8 +134,9 @@ def _check_k(k, n):
     if k < 1:
         raise MeshError(f"k must be at least 1, not {k}")
     if k > n:
-        raise MeshError(f"k = {k} eigenpairs asked for, but the mesh has only {n} vertices "
-                        f"(at most n = {n} eigenpairs exist)")
+        raise MeshError(
+            f"k = {k} eigenpairs asked for, but the mesh has only {n} vertices (at most n = {n} eigenpairs exist)"
+        )
     return k
 
 
@@ -163,9 +163,13 @@ def _tidy(lam, E, m, F):
     E /= np.sqrt(np.einsum("ij,i,ij->j", E, m, E))[None, :]  # Y^T Y = I only to rounding
     count, labels = _components(F, m)
     if count > 1:
-        warnings.warn(f"the mesh has {count} connected components: the first {count} eigenvalues are 0 "
-                      f"and their eigenvectors are the components' indicator functions; each component "
-                      f"has its own spectrum", MeshWarning, stacklevel=3)
+        warnings.warn(
+            f"the mesh has {count} connected components: the first {count} eigenvalues are 0 "
+            f"and their eigenvectors are the components' indicator functions; each component "
+            f"has its own spectrum",
+            MeshWarning,
+            stacklevel=3,
+        )
     c = min(count, len(lam))
     # The solver returns some rotation of the null space (rounding decides which):
     # replace it by the normalised indicator function of each component.
@@ -207,8 +211,10 @@ class SpectralBasis:
         return len(self.lam)
 
     def __repr__(self):
-        return (f"SpectralBasis(n={self.E.shape[0]}, k={self.k}, components={self.components}, "
-                f"lam=[{self.lam[0]:.3g} .. {self.lam[-1]:.3g}], source={self.source!r})")
+        return (
+            f"SpectralBasis(n={self.E.shape[0]}, k={self.k}, components={self.components}, "
+            f"lam=[{self.lam[0]:.3g} .. {self.lam[-1]:.3g}], source={self.source!r})"
+        )
 
     def _k(self, k):
         if k is None:
@@ -253,8 +259,9 @@ class SpectralBasis:
         return np.sqrt(np.maximum(total - np.cumsum((c * c).sum(axis=1)), 0.0))
 
 
-def spectral_basis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None,
-                   method="auto", tol=None):
+def spectral_basis(
+    V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=None
+):
     """The first k eigenpairs as a :class:`SpectralBasis` (cached; see :func:`eigenbasis`).
 
     ``basis.reconstruct(X, j)`` then projects per-vertex values X onto the
@@ -266,8 +273,7 @@ def spectral_basis(V, F, k, weights="cotan", area="barycentric", *, cache=True, 
     basis = _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol)
     if basis.k == k:
         return basis
-    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0,
-                         basis.source)
+    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0, basis.source)
 
 
 def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
@@ -300,8 +306,7 @@ def _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, nam
     return basis
 
 
-def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None,
-                            method="auto"):
+def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto"):
     """``V_k = E (E^T M V)``: the coordinates projected onto the first k eigenvectors.
 
     The projection is orthogonal in the M inner product (``<f, g>_M = f^T M g``,

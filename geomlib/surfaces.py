@@ -571,9 +571,7 @@ def icosphere(subdivisions=3):
         bc = P.shape[0] + inv[m : 2 * m]
         ca = P.shape[0] + inv[2 * m :]
         a, b, c = F[:, 0], F[:, 1], F[:, 2]
-        F = np.concatenate(
-            [np.stack(t, axis=1) for t in ((a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca))]
-        )
+        F = np.concatenate([np.stack(t, axis=1) for t in ((a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca))])
         P = np.concatenate([P, mid])
         F = _canonical_faces(F)
     return P, F
@@ -616,7 +614,9 @@ def _ellipsoid_area(a, b, c):
     phi = np.arccos(c / a)
     m = (a * a * (b * b - c * c)) / (b * b * (a * a - c * c))
     s = np.sin(phi)
-    return 2.0 * np.pi * c * c + 2.0 * np.pi * a * b / s * (ellipeinc(phi, m) * s * s + ellipkinc(phi, m) * (1.0 - s * s))
+    return 2.0 * np.pi * c * c + 2.0 * np.pi * a * b / s * (
+        ellipeinc(phi, m) * s * s + ellipkinc(phi, m) * (1.0 - s * s)
+    )
 
 
 def sphere(r=1.0, subdivisions=3, jitter=0.0, seed=0):
@@ -653,8 +653,15 @@ def sphere(r=1.0, subdivisions=3, jitter=0.0, seed=0):
     params = dict(r=r, subdivisions=subdivisions, jitter=jitter, seed=seed)
     truth = _constant_truth(V.shape[0], P, 1.0 / r, 1.0 / r**2)
     return _make(
-        "sphere", params, V, F, _ellipsoid_uv(V, r, r, r), True, truth,
-        area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3,
+        "sphere",
+        params,
+        V,
+        F,
+        _ellipsoid_uv(V, r, r, r),
+        True,
+        truth,
+        area=4.0 * np.pi * r * r,
+        volume=4.0 / 3.0 * np.pi * r**3,
     )
 
 
@@ -694,8 +701,15 @@ def ellipsoid(a=1.0, b=0.7, c=0.5, subdivisions=3, jitter=0.0, seed=0):
     params = dict(a=a, b=b, c=c, subdivisions=subdivisions, jitter=jitter, seed=seed)
     uv = _ellipsoid_uv(V, a, b, c)
     return _make(
-        "ellipsoid", params, V, F, uv, True, _symbolic_truth("ellipsoid", (a, b, c), uv),
-        area=_ellipsoid_area(a, b, c), volume=4.0 / 3.0 * np.pi * a * b * c,
+        "ellipsoid",
+        params,
+        V,
+        F,
+        uv,
+        True,
+        _symbolic_truth("ellipsoid", (a, b, c), uv),
+        area=_ellipsoid_area(a, b, c),
+        volume=4.0 / 3.0 * np.pi * a * b * c,
     )
 
 
@@ -751,8 +765,15 @@ def uv_ellipsoid(a=1.0, b=0.7, c=0.5, n=16, jitter=0.0, seed=0):
     _check_faces(V, F, V / np.array([a * a, b * b, c * c]), "uv_ellipsoid")
     params = dict(a=a, b=b, c=c, n=n, jitter=jitter, seed=seed)
     return _make(
-        "ellipsoid", params, V, F, uv, True, _symbolic_truth("ellipsoid", (a, b, c), uv),
-        area=_ellipsoid_area(a, b, c), volume=4.0 / 3.0 * np.pi * a * b * c,
+        "ellipsoid",
+        params,
+        V,
+        F,
+        uv,
+        True,
+        _symbolic_truth("ellipsoid", (a, b, c), uv),
+        area=_ellipsoid_area(a, b, c),
+        volume=4.0 / 3.0 * np.pi * a * b * c,
     )
 
 
@@ -770,7 +791,15 @@ def uv_sphere(r=1.0, n=16, jitter=0.0, seed=0):
     params = dict(r=r, n=n, jitter=jitter, seed=seed)
     truth = _constant_truth(V.shape[0], N, 1.0 / r, 1.0 / r**2)
     return _make(
-        "sphere", params, V, F, uv, True, truth, area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3,
+        "sphere",
+        params,
+        V,
+        F,
+        uv,
+        True,
+        truth,
+        area=4.0 * np.pi * r * r,
+        volume=4.0 / 3.0 * np.pi * r**3,
     )
 
 
@@ -832,8 +861,15 @@ def torus(R=1.0, r=0.4, n=64, m=None, jitter=0.0, seed=0):
     params = dict(R=R, r=r, n=n, m=m, jitter=jitter, seed=seed)
     uv = np.stack([u, v], 1)
     return _make(
-        "torus", params, V, F, uv, True, _symbolic_truth("torus", (R, r), uv),
-        area=4.0 * np.pi**2 * R * r, volume=2.0 * np.pi**2 * R * r * r,
+        "torus",
+        params,
+        V,
+        F,
+        uv,
+        True,
+        _symbolic_truth("torus", (R, r), uv),
+        area=4.0 * np.pi**2 * R * r,
+        volume=2.0 * np.pi**2 * R * r * r,
     )
 
 
@@ -933,5 +969,7 @@ def attach_truth(name, V, F, **params):
         area, volume = 4.0 * np.pi**2 * R * r, 2.0 * np.pi**2 * R * r * r
     far = np.flatnonzero(dist > 1e-6 * scale)
     if far.size:
-        raise MeshError(f"vertices {format_indices(far)} are not on the {name} with {p} (off by up to {dist.max():.3g})")
+        raise MeshError(
+            f"vertices {format_indices(far)} are not on the {name} with {p} (off by up to {dist.max():.3g})"
+        )
     return _make(name, p, V, F, uv, closed, truth, area=area, volume=volume)

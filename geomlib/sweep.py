@@ -18,12 +18,20 @@ from .metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
 from .noise import add_noise
 from .smoothing import ImplicitSmoother, explicit_smoothing, explicit_step_limit
 
-__all__ = ["SCHEMES", "EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "SWEEP_ITERATIONS", "SWEEP_KEYS",
-           "HAUSDORFF_SAMPLES_PER_FACE", "scale_free_step", "SmoothingSweep", "smoothing_sweep"]
+__all__ = [
+    "SCHEMES",
+    "EXPLICIT_FRACTIONS",
+    "IMPLICIT_STEPS",
+    "SWEEP_ITERATIONS",
+    "SWEEP_KEYS",
+    "HAUSDORFF_SAMPLES_PER_FACE",
+    "scale_free_step",
+    "SmoothingSweep",
+    "smoothing_sweep",
+]
 
 #: (method, weights) pairs compared by :func:`smoothing_sweep`.
-SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"),
-           ("implicit", "uniform"), ("implicit", "cotan"))
+SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"), ("implicit", "uniform"), ("implicit", "cotan"))
 
 #: Explicit steps of the sweep, as fractions of the stability limit
 #: ``2 / lambda_max`` of the mesh being smoothed (below 1 is stable).
@@ -37,8 +45,7 @@ SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
 
 #: Metric keys recorded by the sweep (all of :meth:`MeshComparison.evaluate`
 #: except the Hausdorff estimate, which is measured for chosen results only).
-SWEEP_KEYS = ("rms", "normal_mean", "normal_p95", "area_change", "volume_change",
-              "sharp_edge_error")
+SWEEP_KEYS = ("rms", "normal_mean", "normal_p95", "area_change", "volume_change", "sharp_edge_error")
 
 
 def scale_free_step(V, F, method, weights, value):
@@ -127,16 +134,31 @@ class SmoothingSweep:
         block = np.where(np.isnan(block), np.inf, block) + mask
         j, k, l = np.unravel_index(int(np.argmin(block)), block.shape)
         method, weights = self.schemes[j]
-        out = {"method": method, "weights": weights,
-               "step_value": self.step_values[method][k], "step": float(self.steps[i, j, k]),
-               "iterations": int(self.iterations[l]), "index": (int(j), int(k), int(l))}
+        out = {
+            "method": method,
+            "weights": weights,
+            "step_value": self.step_values[method][k],
+            "step": float(self.steps[i, j, k]),
+            "iterations": int(self.iterations[l]),
+            "index": (int(j), int(k), int(l)),
+        }
         out.update({name: float(v[i, j, k, l]) for name, v in self.values.items()})
         return out
 
 
-def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fractions=EXPLICIT_FRACTIONS,
-                    implicit_steps=IMPLICIT_STEPS, iterations=SWEEP_ITERATIONS, direction="isotropic",
-                    comparison=None, progress=True):
+def smoothing_sweep(
+    V_clean,
+    F,
+    sigmas,
+    seed,
+    schemes=SCHEMES,
+    explicit_fractions=EXPLICIT_FRACTIONS,
+    implicit_steps=IMPLICIT_STEPS,
+    iterations=SWEEP_ITERATIONS,
+    direction="isotropic",
+    comparison=None,
+    progress=True,
+):
     """Add noise at each level, smooth it with every scheme, step and iteration count, measure.
 
     For every noise level ``sigma`` (a fraction of the bounding-box
@@ -182,8 +204,10 @@ def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fraction
     step_values = {"explicit": tuple(explicit_fractions), "implicit": tuple(implicit_steps)}
     for method, weights in schemes:
         if method not in step_values or weights not in ("uniform", "cotan"):
-            raise MeshError(f"unknown scheme ({method!r}, {weights!r}); methods are 'explicit' and "
-                            "'implicit', weights 'uniform' and 'cotan'")
+            raise MeshError(
+                f"unknown scheme ({method!r}, {weights!r}); methods are 'explicit' and "
+                "'implicit', weights 'uniform' and 'cotan'"
+            )
     out = SmoothingSweep(sigmas, schemes, step_values, iterations)
     where = {int(k): l for l, k in enumerate(iterations)}
     last = int(iterations[-1])
@@ -213,8 +237,9 @@ def smoothing_sweep(V_clean, F, sigmas, seed, schemes=SCHEMES, explicit_fraction
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore", MeshWarning)
                         if method == "explicit":
-                            explicit_smoothing(Vn, C.F, step, last, weights, callback=record,
-                                               on_failure="stop", progress=False)
+                            explicit_smoothing(
+                                Vn, C.F, step, last, weights, callback=record, on_failure="stop", progress=False
+                            )
                         else:
                             smoother.smooth(step, last, callback=record, progress=False)
                     if bar is not None:

@@ -185,9 +185,23 @@ class ParametricSurface:
         random points (torus: R > r).
     """
 
-    def __init__(self, p, u, v, *, params=(), values=None, normal_direction=None,
-                 area_factor=1, orientation=1, domain=None, name="surface", closed=False,
-                 check_values=None, _family=None):
+    def __init__(
+        self,
+        p,
+        u,
+        v,
+        *,
+        params=(),
+        values=None,
+        normal_direction=None,
+        area_factor=1,
+        orientation=1,
+        domain=None,
+        name="surface",
+        closed=False,
+        check_values=None,
+        _family=None,
+    ):
         if orientation not in (1, -1):
             raise ValueError(f"orientation must be +1 or -1, got {orientation!r}")
         self.u, self.v = u, v
@@ -205,8 +219,11 @@ class ParametricSurface:
             # A member of a family: symbolic results come from the family by substitution.
             self._family = _family
             self.p = sp.Matrix(_family.p).subs(self.values)
-            self.domain = None if _family.domain is None else tuple(
-                tuple(sp.sympify(x).subs(self.values) for x in rng) for rng in _family.domain)
+            self.domain = (
+                None
+                if _family.domain is None
+                else tuple(tuple(sp.sympify(x).subs(self.values) for x in rng) for rng in _family.domain)
+            )
             return
         self._family = None
         self.p = sp.Matrix(p)
@@ -232,9 +249,17 @@ class ParametricSurface:
             raise ValueError(f"unknown parameter(s) {bad}; this surface has {sorted(by_name)}")
         merged = dict(self.values)
         merged.update({by_name[k]: x for k, x in values.items()})
-        return ParametricSurface(None, fam.u, fam.v, params=fam.params, values=merged,
-                                 orientation=fam.orientation, name=fam.name, closed=fam.closed,
-                                 _family=fam)
+        return ParametricSurface(
+            None,
+            fam.u,
+            fam.v,
+            params=fam.params,
+            values=merged,
+            orientation=fam.orientation,
+            name=fam.name,
+            closed=fam.closed,
+            _family=fam,
+        )
 
     def _check_normal_hint(self, check_values):
         """Check p_u x p_v = orientation * area_factor * D numerically at random points."""
@@ -248,14 +273,17 @@ class ParametricSurface:
             sub[self.v] = float(rng.uniform(0.1, 1.4))
             af = complex(self._area_factor.evalf(subs=sub)).real
             if af < 0:
-                raise ValueError(f"area_factor = {self._area_factor} is negative at {sub}; it must be >= 0 "
-                                 "on the domain (put the sign into orientation)")
+                raise ValueError(
+                    f"area_factor = {self._area_factor} is negative at {sub}; it must be >= 0 "
+                    "on the domain (put the sign into orientation)"
+                )
             lhs = np.array([complex(x.evalf(subs=sub)) for x in cross])
             rhs = np.array([complex((self._area_factor * d).evalf(subs=sub)) for d in self._D]) * self.orientation
             if not np.allclose(lhs, rhs, atol=1e-9 * (1 + np.abs(lhs).max())):
                 raise ValueError(
                     f"normal_direction/area_factor/orientation do not reproduce p_u x p_v at {sub}: "
-                    f"p_u x p_v = {lhs.real}, orientation*area_factor*D = {rhs.real}")
+                    f"p_u x p_v = {lhs.real}, orientation*area_factor*D = {rhs.real}"
+                )
 
     def _get(self, key, compute):
         """Cache; for family members take the family's result and substitute."""
@@ -316,14 +344,14 @@ class ParametricSurface:
         _, DD, af = self._normal_parts()
         I = self.first_fundamental_form()
         E, F, G = I[0, 0], I[0, 1], I[1, 1]
-        k_num = _tidy(sp.cancel((en * gn - fn ** 2) / af ** 2))
-        h_num = _tidy(sp.cancel((en * G - 2 * fn * F + gn * E) / af ** 2))
+        k_num = _tidy(sp.cancel((en * gn - fn**2) / af**2))
+        h_num = _tidy(sp.cancel((en * G - 2 * fn * F + gn * E) / af**2))
         return (k_num, h_num)
 
     def _c_gaussian_curvature(self):
         k_num, _ = self._get("curvature_numerators", self._c_curvature_numerators)
         _, DD, _ = self._normal_parts()
-        return k_num / DD ** 2
+        return k_num / DD**2
 
     def _c_mean_curvature(self):
         _, h_num = self._get("curvature_numerators", self._c_curvature_numerators)
@@ -334,7 +362,7 @@ class ParametricSurface:
         # k = H +- sqrt(H^2 - K) = (h_num +- sqrt(h_num^2 - 4 k_num W^2)) / (2 W^3)
         k_num, h_num = self._get("curvature_numerators", self._c_curvature_numerators)
         _, DD, _ = self._normal_parts()
-        root = sp.sqrt(_tidy(h_num ** 2 - 4 * k_num * DD))
+        root = sp.sqrt(_tidy(h_num**2 - 4 * k_num * DD))
         den = 2 * DD ** sp.Rational(3, 2)
         return ((h_num + root) / den, (h_num - root) / den)
 
@@ -343,7 +371,7 @@ class ParametricSurface:
         _, DD, af = self._normal_parts()
         I = self.first_fundamental_form()
         num = I.adjugate() * sp.Matrix([[en, fn], [fn, gn]])
-        return num.applyfunc(lambda x: _tidy(sp.cancel(x / af ** 2))) / DD ** sp.Rational(3, 2)
+        return num.applyfunc(lambda x: _tidy(sp.cancel(x / af**2))) / DD ** sp.Rational(3, 2)
 
     def _c_area_element(self):
         _, DD, af = self._normal_parts()
@@ -372,7 +400,7 @@ class ParametricSurface:
         W = sp.sqrt(DD)
         A = _tidy(sp.cancel(en / E)) / W
         B = _tidy(sp.cancel((fn * E - en * F) / (E * af))) / DD
-        C = _tidy(sp.cancel((en * F ** 2 - 2 * fn * F * E + gn * E ** 2) / (E * af ** 2))) / W ** 3
+        C = _tidy(sp.cancel((en * F**2 - 2 * fn * F * E + gn * E**2) / (E * af**2))) / W**3
         return (A, B, C)
 
     # ------------------------------------------------------ public, symbolic
@@ -480,7 +508,7 @@ class ParametricSurface:
             return self._get("principal_curvatures", self._c_principal_curvatures)
         A, B, C = self._point("frame_coefficients", u, v)
         H = _tidy((A + C) / 2)
-        R = _tidy(sp.sqrt(((A - C) / 2) ** 2 + B ** 2))
+        R = _tidy(sp.sqrt(((A - C) / 2) ** 2 + B**2))
         return (_tidy(H + R), _tidy(H - R))
 
     def principal_directions(self, u, v):
@@ -602,24 +630,29 @@ class ParametricSurface:
             return [np.broadcast_to(np.asarray(c, dtype=float), shape) for c in comps], shape
 
         if name in ("position", "p_u", "p_v", "unit_normal"):
+
             def f(u, v, *rest):
                 comps, shape = evaluate(name, u, v, rest)
                 return np.stack(comps, axis=-1)
         elif name in ("first_fundamental_form", "second_fundamental_form", "shape_operator"):
+
             def f(u, v, *rest):
                 comps, shape = evaluate(name, u, v, rest)
                 return np.stack(comps, axis=-1).reshape(shape + (2, 2))
         elif name in ("gaussian_curvature", "mean_curvature", "area_element"):
+
             def f(u, v, *rest):
                 comps, shape = evaluate(name, u, v, rest)
                 return np.array(comps[0])
         elif name == "principal_curvatures":
+
             def f(u, v, *rest):
                 (A, B, C), _ = evaluate("frame_coefficients", u, v, rest)
                 H = 0.5 * (A + C)
                 R = np.hypot(0.5 * (A - C), B)
                 return H + R, H - R
         elif name == "principal_directions":
+
             def f(u, v, *rest):
                 u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
                 # Where the parameterisation is singular (p_u or p_v = 0, e.g. the
@@ -646,11 +679,13 @@ class ParametricSurface:
                 d2 = -np.sin(phi1) * e1 + np.cos(phi1) * w
                 return d1, d2
         else:  # normal_curvature
+
             def f(u, v, phi, *rest):
                 (A, B, C), _ = evaluate("frame_coefficients", u, v, rest)
                 phi = np.asarray(phi, dtype=float)
                 c, s = np.cos(phi), np.sin(phi)
                 return A * c * c + 2 * B * s * c + C * s * s
+
         f.__name__ = name
         f.__doc__ = f"{name} of {self!r}: {LAMBDIFY_NAMES[name]}"
         return f
@@ -667,9 +702,18 @@ def _ellipsoid_family():
     p = (a * sp.cos(u) * sp.sin(v), b * sp.sin(u) * sp.sin(v), c * sp.cos(v))
     # p_u x p_v = -sin(v) * (bc cos u sin v, ac sin u sin v, ab cos v): inward for 0 < v < pi
     D = (b * c * sp.cos(u) * sp.sin(v), a * c * sp.sin(u) * sp.sin(v), a * b * sp.cos(v))
-    return ParametricSurface(p, u, v, params=(a, b, c), normal_direction=D, area_factor=sp.sin(v),
-                             orientation=-1, domain=((0, 2 * sp.pi), (0, sp.pi)), name="ellipsoid",
-                             closed=True)
+    return ParametricSurface(
+        p,
+        u,
+        v,
+        params=(a, b, c),
+        normal_direction=D,
+        area_factor=sp.sin(v),
+        orientation=-1,
+        domain=((0, 2 * sp.pi), (0, sp.pi)),
+        name="ellipsoid",
+        closed=True,
+    )
 
 
 def _member(family, args):
@@ -679,9 +723,17 @@ def _member(family, args):
             raise ValueError(f"{family.name}: parameter {s} must be positive, got {x}")
     if all(vals[s] == s for s in family.params):
         return family
-    return ParametricSurface(None, family.u, family.v, params=family.params, values=vals,
-                             orientation=family.orientation, name=family.name,
-                             closed=family.closed, _family=family)
+    return ParametricSurface(
+        None,
+        family.u,
+        family.v,
+        params=family.params,
+        values=vals,
+        orientation=family.orientation,
+        name=family.name,
+        closed=family.closed,
+        _family=family,
+    )
 
 
 def ellipsoid(a, b, c):
@@ -726,9 +778,18 @@ def _sphere_family():
     u, v = _U, _V
     p = (r * sp.cos(u) * sp.sin(v), r * sp.sin(u) * sp.sin(v), r * sp.cos(v))
     D = (sp.cos(u) * sp.sin(v), sp.sin(u) * sp.sin(v), sp.cos(v))
-    return ParametricSurface(p, u, v, params=(r,), normal_direction=D, area_factor=r ** 2 * sp.sin(v),
-                             orientation=-1, domain=((0, 2 * sp.pi), (0, sp.pi)), name="sphere",
-                             closed=True)
+    return ParametricSurface(
+        p,
+        u,
+        v,
+        params=(r,),
+        normal_direction=D,
+        area_factor=r**2 * sp.sin(v),
+        orientation=-1,
+        domain=((0, 2 * sp.pi), (0, sp.pi)),
+        name="sphere",
+        closed=True,
+    )
 
 
 def sphere(r=1):
@@ -746,9 +807,19 @@ def _torus_family():
     rho = R + r * sp.cos(v)
     p = (rho * sp.cos(u), rho * sp.sin(u), r * sp.sin(v))
     D = (sp.cos(u) * sp.cos(v), sp.sin(u) * sp.cos(v), sp.sin(v))
-    return ParametricSurface(p, u, v, params=(R, r), normal_direction=D, area_factor=r * rho,
-                             orientation=1, domain=((0, 2 * sp.pi), (0, 2 * sp.pi)), name="torus",
-                             closed=True, check_values={R: 2.0, r: 0.7})
+    return ParametricSurface(
+        p,
+        u,
+        v,
+        params=(R, r),
+        normal_direction=D,
+        area_factor=r * rho,
+        orientation=1,
+        domain=((0, 2 * sp.pi), (0, 2 * sp.pi)),
+        name="torus",
+        closed=True,
+        check_values={R: 2.0, r: 0.7},
+    )
 
 
 def torus(R=2, r=sp.Rational(1, 2)):
@@ -769,8 +840,7 @@ def _helicoid_family():
     c = sp.symbols("c", positive=True)
     u, v = _U, _V
     p = (u * sp.cos(v), u * sp.sin(v), c * v)
-    return ParametricSurface(p, u, v, params=(c,), domain=((-1, 1), (0, 2 * sp.pi)),
-                             name="helicoid", closed=False)
+    return ParametricSurface(p, u, v, params=(c,), domain=((-1, 1), (0, 2 * sp.pi)), name="helicoid", closed=False)
 
 
 def helicoid(c=1):
@@ -803,4 +873,4 @@ def monge(h, x=None, y=None, domain=((-1, 1), (-1, 1)), name="monge patch"):
 def saddle(k=1):
     """The saddle z = k (x^2 - y^2): at the origin K = -4 k^2, H = 0."""
     x, y = sp.symbols("x y", real=True)
-    return monge(_exact(k) * (x ** 2 - y ** 2), x, y, name="saddle")
+    return monge(_exact(k) * (x**2 - y**2), x, y, name="saddle")

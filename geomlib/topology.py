@@ -203,7 +203,9 @@ class Topology:
         gs = self.group_start[multi]
         cnt = self.edge_face_count[multi]
         first_pos = np.repeat(gs, cnt - 1)
-        other_pos = first_pos + (np.arange(int((cnt - 1).sum())) - np.repeat(np.cumsum(cnt - 1) - (cnt - 1), cnt - 1)) + 1
+        other_pos = (
+            first_pos + (np.arange(int((cnt - 1).sum())) - np.repeat(np.cumsum(cnt - 1) - (cnt - 1), cnt - 1)) + 1
+        )
         h1 = self.order[first_pos]
         h2 = self.order[other_pos]
         end1 = h1 - h1 % 3 + (h1 % 3 + 1) % 3
@@ -233,7 +235,7 @@ class Topology:
     def duplicate_faces(self):
         F, n = self.F, self.n
         S = np.sort(F, axis=1)
-        if n ** 3 < _INT64_MAX:
+        if n**3 < _INT64_MAX:
             key = (S[:, 0] * n + S[:, 1]) * n + S[:, 2]
         else:  # rows as one void item each, compared bytewise
             key = np.ascontiguousarray(S).view(np.dtype((np.void, 24))).ravel()
@@ -475,8 +477,7 @@ def one_ring(F, i):
     starts = sorted(set(a.tolist()) - set(b.tolist()))
     if len(starts) > 1:
         raise MeshError(
-            f"one_ring: vertex {i} is non-manifold: its faces {format_indices(rows)} form {len(starts)} "
-            "separate fans"
+            f"one_ring: vertex {i} is non-manifold: its faces {format_indices(rows)} form {len(starts)} separate fans"
         )
     start = starts[0] if starts else int(a[0])
     ring = [start]
@@ -545,9 +546,7 @@ def vertex_face_adjacency(F, n=None):
     F = as_faces(F, n)
     n = _nverts(F, n)
     m = len(F)
-    return sp.csr_matrix(
-        (np.ones(3 * m, np.int8), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m)
-    )
+    return sp.csr_matrix((np.ones(3 * m, np.int8), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(n, m))
 
 
 def edge_face_counts(F, n=None):

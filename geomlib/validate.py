@@ -100,8 +100,7 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
         more = f" (and {len(rows) - 5} more faces)" if len(rows) > 5 else ""
         valid = "non-negative" if n is None else f"0..{n - 1} for {n} vertices"
         raise MeshError(
-            f"{_prefix(where)}face indices out of range (valid: {valid}): {detail}{more}; "
-            f"faces {format_indices(rows)}"
+            f"{_prefix(where)}face indices out of range (valid: {valid}): {detail}{more}; faces {format_indices(rows)}"
         )
     rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
     if rep.any():
@@ -199,9 +198,11 @@ def zero_area_faces(V, F, rtol=ZERO_AREA_RTOL):
     # coordinate by coordinate (validate sits below geometry, so it cannot call geometry.face_cross)
     X, Y, Z = np.ascontiguousarray(V.T)
     i, j, k = np.ascontiguousarray(F.T)
-    ax, ay, az = X[j] - X[i], Y[j] - Y[i], Z[j] - Z[i]       # a = v1 - v0
-    bx, by, bz = X[k] - X[i], Y[k] - Y[i], Z[k] - Z[i]       # b = v2 - v0
+    ax, ay, az = X[j] - X[i], Y[j] - Y[i], Z[j] - Z[i]  # a = v1 - v0
+    bx, by, bz = X[k] - X[i], Y[k] - Y[i], Z[k] - Z[i]  # b = v2 - v0
     dblA = np.sqrt((ay * bz - az * by) ** 2 + (az * bx - ax * bz) ** 2 + (ax * by - ay * bx) ** 2)
-    longest2 = np.maximum(np.maximum(ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz),
-                          (bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2)
+    longest2 = np.maximum(
+        np.maximum(ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz),
+        (bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2,
+    )
     return np.flatnonzero(is_zero_area(dblA, longest2, rtol))

@@ -101,8 +101,7 @@ import scipy.sparse as sp
 
 from .errors import MeshError, format_indices
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fast", "render_still",
-           "box_still"]
+__all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fast", "render_still", "box_still"]
 
 #: colour of vertices whose value is NaN (RGB in [0, 1])
 NAN_COLOR = (0.62, 0.62, 0.62)
@@ -166,6 +165,7 @@ void main() {
 # input checks
 # ----------------------------------------------------------------------------
 
+
 def _check_vertices(V, n=None, name="V"):
     try:
         V = np.asarray(V, dtype=np.float64)
@@ -174,8 +174,10 @@ def _check_vertices(V, n=None, name="V"):
     if V.ndim != 2 or V.shape[1] != 3:
         raise MeshError(f"{name} must have shape (n, 3); got {V.shape}")
     if n is not None and V.shape[0] != n:
-        raise MeshError(f"{name} has {V.shape[0]} vertices; the view was built with {n} "
-                        "(the vertex count cannot change in update; make a new MeshView)")
+        raise MeshError(
+            f"{name} has {V.shape[0]} vertices; the view was built with {n} "
+            "(the vertex count cannot change in update; make a new MeshView)"
+        )
     bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
     if bad.size:
         raise MeshError(f"{name} has non-finite coordinates at vertices {format_indices(bad)}")
@@ -216,6 +218,7 @@ def _check_values(values, n):
 # ----------------------------------------------------------------------------
 # colour mapping and normals (pure functions, vectorised)
 # ----------------------------------------------------------------------------
+
 
 def _get_cmap(cmap):
     import matplotlib
@@ -335,6 +338,7 @@ def vertex_normals_fast(V, F, S=None):
 # camera and the still picture
 # ----------------------------------------------------------------------------
 
+
 def _closed_outward(V, F):
     """True when every directed edge (i, j) has its reverse (j, i): a closed,
     consistently oriented mesh, and its enclosed volume is positive (faces
@@ -344,10 +348,10 @@ def _closed_outward(V, F):
     i, j = F.ravel(), F[:, [1, 2, 0]].ravel()
     key = np.sort(i * n + j)
     if key.size > 1 and (key[1:] == key[:-1]).any():
-        return False                      # an edge used twice in the same direction
+        return False  # an edge used twice in the same direction
     reverse = np.sort(j * n + i)
     if not np.array_equal(key, reverse):
-        return False                      # a boundary, or orientation flips somewhere
+        return False  # a boundary, or orientation flips somewhere
     p0, p1, p2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     return float(np.einsum("ij,ij->", p0, np.cross(p1, p2))) > 0
 
@@ -395,8 +399,20 @@ def _look_at_quaternion(direction, up=UP):
     return tuple(float(x) for x in q)
 
 
-def render_still(V, F, colors, normals=None, width=420, height=340, direction=VIEW_DIRECTION,
-                 up=UP, distance=None, fov=FOV, background=(1.0, 1.0, 1.0), centre=None):
+def render_still(
+    V,
+    F,
+    colors,
+    normals=None,
+    width=420,
+    height=340,
+    direction=VIEW_DIRECTION,
+    up=UP,
+    distance=None,
+    fov=FOV,
+    background=(1.0, 1.0, 1.0),
+    centre=None,
+):
     """Draw the mesh as the viewer's camera first sees it, into an RGB image.
 
     The camera looks at ``centre`` (default: the centre of V's bounding box)
@@ -420,7 +436,7 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
     right, up, w = _basis(direction, up)
     P = V - centre
     eye = w * distance
-    depth = distance - P @ w                      # distance along the viewing axis
+    depth = distance - P @ w  # distance along the viewing axis
     depth = np.maximum(depth, 1e-6 * distance)
     f = (height / 2) / np.tan(np.radians(fov) / 2)
     sx = width / 2 + f * (P @ right) / depth
@@ -431,10 +447,10 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
     to_eye /= np.linalg.norm(to_eye, axis=1, keepdims=True)
     d = np.abs(np.einsum("ij,ij->i", normals, to_eye))
     shade = 0.35 + 0.65 * d
-    vc = np.asarray(colors, dtype=np.float64)[:, :3] * shade[:, None] + 0.12 * (d ** 40)[:, None]
+    vc = np.asarray(colors, dtype=np.float64)[:, :3] * shade[:, None] + 0.12 * (d**40)[:, None]
     inv = 1.0 / depth
 
-    X, Y = sx[F], sy[F]                           # (m, 3) screen corners
+    X, Y = sx[F], sy[F]  # (m, 3) screen corners
     x0 = np.floor(X.min(axis=1) - 0.5).astype(np.int64)
     y0 = np.floor(Y.min(axis=1) - 0.5).astype(np.int64)
     x1 = np.floor(X.max(axis=1) - 0.5).astype(np.int64) + 1
@@ -455,7 +471,7 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
         ox, oy = ox.ravel(), oy.ravel()
         chunk = max(1, 2_000_000 // int(sw * sh))
         for start in range(0, ids.size, chunk):
-            fi = ids[start:start + chunk]
+            fi = ids[start : start + chunk]
             px = x0[fi, None] + ox[None, :]
             py = y0[fi, None] + oy[None, :]
             cx, cy = px + 0.5, py + 0.5
@@ -471,8 +487,7 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
             ff = F[fi[r]]
             bb0, bb1, bb2 = b0[r, c], b1[r, c], b2[r, c]
             key = bb0 * inv[ff[:, 0]] + bb1 * inv[ff[:, 1]] + bb2 * inv[ff[:, 2]]
-            col = (bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]]
-                   + bb2[:, None] * vc[ff[:, 2]])
+            col = bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]] + bb2[:, None] * vc[ff[:, 2]]
             pix_all.append(py[r, c] * width + px[r, c])
             key_all.append(key)
             col_all.append(col)
@@ -482,7 +497,7 @@ def render_still(V, F, colors, normals=None, width=420, height=340, direction=VI
         pix = np.concatenate(pix_all)
         key = np.concatenate(key_all)
         col = np.concatenate(col_all)
-        order = np.lexsort((-key, pix))           # by pixel, nearest (largest 1/z) first
+        order = np.lexsort((-key, pix))  # by pixel, nearest (largest 1/z) first
         pix, col = pix[order], col[order]
         first = np.ones(pix.size, dtype=bool)
         first[1:] = pix[1:] != pix[:-1]
@@ -505,8 +520,10 @@ def _colorbar_html(lut, vmin, vmax, label, n_nan, width):
     nan_text = ""
     if n_nan:
         grey = "rgb({},{},{})".format(*(int(c * 255) for c in NAN_COLOR))
-        nan_text = (f'<span style="display:inline-block;width:10px;height:10px;background:{grey};'
-                    f'margin:0 3px 0 8px"></span>NaN ({n_nan})')
+        nan_text = (
+            f'<span style="display:inline-block;width:10px;height:10px;background:{grey};'
+            f'margin:0 3px 0 8px"></span>NaN ({n_nan})'
+        )
     label_html = f"<div style='text-align:center'>{html.escape(label)}{nan_text}</div>" if (label or nan_text) else ""
     return (
         f"<div class='geomlib-colorbar' style='width:{width}px;font:12px sans-serif;color:#222'>"
@@ -519,9 +536,11 @@ def _colorbar_html(lut, vmin, vmax, label, n_nan, width):
 
 def _zero_html(text, label, width):
     label_html = f"<div style='text-align:center'>{html.escape(label)}</div>" if label else ""
-    return (f"<div class='geomlib-colorbar geomlib-zero' style='width:{width}px;font:12px sans-serif;"
-            f"color:#222'><div style='border:1px solid #888;background:#fff;text-align:center'>"
-            f"{html.escape(text)}</div>{label_html}</div>")
+    return (
+        f"<div class='geomlib-colorbar geomlib-zero' style='width:{width}px;font:12px sans-serif;"
+        f"color:#222'><div style='border:1px solid #888;background:#fff;text-align:center'>"
+        f"{html.escape(text)}</div>{label_html}</div>"
+    )
 
 
 def _still_with_colorbar(image, lut, vmin, vmax, label, title):
@@ -564,6 +583,7 @@ def _png(image):
 # ----------------------------------------------------------------------------
 # the view
 # ----------------------------------------------------------------------------
+
 
 class MeshView:
     """An interactive 3D view of a triangle mesh, optionally coloured by a per-vertex scalar.
@@ -622,9 +642,24 @@ class MeshView:
         values not of length n or infinite, unknown colour map.
     """
 
-    def __init__(self, V, F, values=None, cmap=None, symmetric=False, vmin=None, vmax=None,
-                 wireframe=False, width=420, height=340, title=None, label=None, up="z",
-                 frame=None, zero_tol=ZERO_TOL):
+    def __init__(
+        self,
+        V,
+        F,
+        values=None,
+        cmap=None,
+        symmetric=False,
+        vmin=None,
+        vmax=None,
+        wireframe=False,
+        width=420,
+        height=340,
+        title=None,
+        label=None,
+        up="z",
+        frame=None,
+        zero_tol=ZERO_TOL,
+    ):
         import ipywidgets as widgets
         import pythreejs as three
 
@@ -648,7 +683,7 @@ class MeshView:
         self._up, self._direction = VIEWS[up]
         self.zero_tol = float(zero_tol)
         self._centre, self._radius = _frame(V if frame is None else _check_vertices(frame, name="frame"))
-        self._scale = 1.0           # drawn this many times larger (side_by_side enlarges specks)
+        self._scale = 1.0  # drawn this many times larger (side_by_side enlarges specks)
         self._distance = _camera_distance(self._radius, self.width, self.height)
 
         # one interleaved float32 buffer: position (0:3), normal (3:6), colour (6:9)
@@ -657,17 +692,24 @@ class MeshView:
         normal = three.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=3, normalized=False)
         color = three.InterleavedBufferAttribute(data=self._buffer, itemSize=3, offset=6, normalized=False)
         index = three.BufferAttribute(array=self._F.astype(np.uint32).ravel(), normalized=False)
-        self.geometry = three.BufferGeometry(index=index, attributes={
-            "position": position, "normal": normal, "color": color})
+        self.geometry = three.BufferGeometry(
+            index=index, attributes={"position": position, "normal": normal, "color": color}
+        )
         # closed outward meshes: back faces are hidden anyway and skipping them
         # halves the software rasteriser's work; open or inconsistently oriented
         # meshes show both sides
         self.closed = _closed_outward(V, self._F)
         material = three.ShaderMaterial(
-            vertexShader=_VERTEX_SHADER, fragmentShader=_FRAGMENT_SHADER,
-            vertexColors="VertexColors", side="FrontSide" if self.closed else "DoubleSide",
-            lights=False, fog=False,
-            polygonOffset=True, polygonOffsetFactor=1.0, polygonOffsetUnits=1.0)
+            vertexShader=_VERTEX_SHADER,
+            fragmentShader=_FRAGMENT_SHADER,
+            vertexColors="VertexColors",
+            side="FrontSide" if self.closed else "DoubleSide",
+            lights=False,
+            fog=False,
+            polygonOffset=True,
+            polygonOffsetFactor=1.0,
+            polygonOffsetUnits=1.0,
+        )
         self.mesh = three.Mesh(geometry=self.geometry, material=material)
         children = [self.mesh]
         if wireframe:
@@ -675,31 +717,43 @@ class MeshView:
             E = np.unique(E, axis=0)
             lines = three.BufferGeometry(
                 index=three.BufferAttribute(array=E.astype(np.uint32).ravel(), normalized=False),
-                attributes={"position": position})
+                attributes={"position": position},
+            )
             self.wireframe = three.LineSegments(
-                geometry=lines,
-                material=three.LineBasicMaterial(color="#1a1a1a", transparent=True, opacity=0.45))
+                geometry=lines, material=three.LineBasicMaterial(color="#1a1a1a", transparent=True, opacity=0.45)
+            )
             children.append(self.wireframe)
         else:
             self.wireframe = None
         self.scene = three.Scene(children=children, background="#ffffff")
         self.camera = three.PerspectiveCamera(
-            fov=FOV, aspect=self.width / self.height,
-            near=self._distance * 0.01, far=self._distance * 100.0,
+            fov=FOV,
+            aspect=self.width / self.height,
+            near=self._distance * 0.01,
+            far=self._distance * 100.0,
             position=tuple(float(x) for x in _basis(self._direction, self._up)[2] * self._distance),
-            quaternion=_look_at_quaternion(self._direction, self._up), up=self._up)
+            quaternion=_look_at_quaternion(self._direction, self._up),
+            up=self._up,
+        )
         self.controls = three.OrbitControls(controlling=self.camera, target=(0.0, 0.0, 0.0))
         antialias = (self._n <= ANTIALIAS_MAX_VERTICES) if ANTIALIAS == "auto" else bool(ANTIALIAS)
-        self.renderer = three.Renderer(camera=self.camera, scene=self.scene, controls=[self.controls],
-                                       width=self.width, height=self.height, antialias=antialias)
+        self.renderer = three.Renderer(
+            camera=self.camera,
+            scene=self.scene,
+            controls=[self.controls],
+            width=self.width,
+            height=self.height,
+            antialias=antialias,
+        )
         self.renderer.add_class("geomlib-canvas")
 
-        self._title = widgets.HTML(self._title_text(),
-                                   layout=widgets.Layout(display=None if title else "none"))
-        self._colorbar = widgets.HTML(self._colorbar_text(),
-                                      layout=widgets.Layout(display=None if self._values is not None else "none"))
-        self.widget = widgets.VBox([self._title, self.renderer, self._colorbar],
-                                   layout=widgets.Layout(width="auto", align_items="flex-start"))
+        self._title = widgets.HTML(self._title_text(), layout=widgets.Layout(display=None if title else "none"))
+        self._colorbar = widgets.HTML(
+            self._colorbar_text(), layout=widgets.Layout(display=None if self._values is not None else "none")
+        )
+        self.widget = widgets.VBox(
+            [self._title, self.renderer, self._colorbar], layout=widgets.Layout(width="auto", align_items="flex-start")
+        )
         self.widget.add_class("geomlib-view")
         _SHOWN[self.widget.model_id] = self
 
@@ -846,9 +900,18 @@ class MeshView:
     def still(self, distance=None):
         """(h, w, 3) uint8 still picture: the first camera view, title and colour bar."""
         buf = self._buffer.array
-        image = render_still(self._V, self._F, buf[:, 6:9], buf[:, 3:6].astype(np.float64),
-                             self.width, self.height, direction=self._direction, up=self._up,
-                             distance=(distance or self._distance) / self._scale, centre=self._centre)
+        image = render_still(
+            self._V,
+            self._F,
+            buf[:, 6:9],
+            buf[:, 3:6].astype(np.float64),
+            self.width,
+            self.height,
+            direction=self._direction,
+            up=self._up,
+            distance=(distance or self._distance) / self._scale,
+            centre=self._centre,
+        )
         lo, hi = self.range
         lut = self._lut if self._values is not None and not self.is_zero else None
         title = self.title
@@ -992,7 +1055,7 @@ def side_by_side(*views, link_cameras=True):
     distance = None
     if link_cameras and len(views) > 1:
         first = views[0]
-        groups = []                               # views of one mesh: (radius, [views])
+        groups = []  # views of one mesh: (radius, [views])
         for v in views:
             for group in groups:
                 if np.array_equal(group[1][0]._F, v._F):

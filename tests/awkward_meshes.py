@@ -37,7 +37,7 @@ def scan_with_holes(folder):
     F = blob.F[~cut]
     used = np.unique(F)
     unused = np.setdiff1d(np.arange(len(V)), used)[:12]
-    keep = np.concatenate([used, unused])          # 12 vertices that no face uses stay in the file
+    keep = np.concatenate([used, unused])  # 12 vertices that no face uses stay in the file
     remap = np.full(len(V), -1)
     remap[keep] = np.arange(len(keep))
     colours = rng.uniform(0.3, 0.9, size=(len(keep), 3))
@@ -59,14 +59,18 @@ def cad_part(folder):
 
 def y_up_millimetres(folder):
     V, F = load_mesh(data_path("sphere.obj"))
-    V = 1000.0 * V[:, [0, 2, 1]] * [1, 1, -1]      # z-up -> y-up (a right-handed rotation), metres -> mm
+    V = 1000.0 * V[:, [0, 2, 1]] * [1, 1, -1]  # z-up -> y-up (a right-handed rotation), metres -> mm
     path = folder / "sphere_y_up_mm.obj"
     save_mesh(path, V, F)
     return path
 
 
-ALL = {"scan_with_holes": scan_with_holes, "two_components": two_components,
-       "cad_part": cad_part, "y_up_millimetres": y_up_millimetres}
+ALL = {
+    "scan_with_holes": scan_with_holes,
+    "two_components": two_components,
+    "cad_part": cad_part,
+    "y_up_millimetres": y_up_millimetres,
+}
 
 
 def make_all(folder):

@@ -88,8 +88,7 @@ def run_notebook(name, timeout=600, **parameters):
         work = Path(tmp) / "notebooks"
         shutil.copytree(NOTEBOOKS, work, ignore=shutil.ignore_patterns("*.ipynb"))
         env = dict(os.environ, GEOMLIB_STRICT_CLAIMS="0", GEOMLIB_CACHE_DIR=str(Path(tmp) / "cache"))
-        client = NotebookClient(nb, timeout=timeout, kernel_name="python3",
-                                resources={"metadata": {"path": str(work)}})
+        client = NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(work)}})
         error, start = "", time.perf_counter()
         saved = dict(os.environ)
         os.environ.update(env)  # the kernel inherits the environment of this process

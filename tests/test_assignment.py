@@ -19,16 +19,13 @@ EXERCISE_NOTEBOOKS = [p for p in NOTEBOOKS if not p.name.startswith("00_")]
 
 
 def test_a_solution_block_becomes_a_stub_at_its_indentation():
-    source = ("def f(V, F):\n"
-              "    \"\"\"Doc.\"\"\"\n"
-              "    ### BEGIN SOLUTION\n"
-              "    M = 1\n"
-              "    return M\n"
-              "    ### END SOLUTION\n")
+    source = 'def f(V, F):\n    """Doc."""\n    ### BEGIN SOLUTION\n    M = 1\n    return M\n    ### END SOLUTION\n'
     out = build_assignment.stub_source(source, "uniform_laplacian", "section 2")
-    assert out == ('def f(V, F):\n    """Doc."""\n'
-                   '    raise NotImplementedError("Your turn: write this (uniform_laplacian). '
-                   'Reread section 2, then run the check below.")')
+    assert out == (
+        'def f(V, F):\n    """Doc."""\n'
+        '    raise NotImplementedError("Your turn: write this (uniform_laplacian). '
+        'Reread section 2, then run the check below.")'
+    )
 
 
 def test_unbalanced_markers_are_refused():
@@ -53,17 +50,30 @@ def test_every_exercise_is_stubbed_and_nothing_else_changes(assignment, path):
     assert len(stubbed.cells) == len(solution.cells)
     for i, (a, b) in enumerate(zip(solution.cells, stubbed.cells)):
         if i in dict(marked):
-            assert "BEGIN SOLUTION" not in b.source and "NotImplementedError(\"Your turn" in b.source
-            assert b.source.splitlines()[0] == a.source.splitlines()[0]     # the def line stays
+            assert "BEGIN SOLUTION" not in b.source and 'NotImplementedError("Your turn' in b.source
+            assert b.source.splitlines()[0] == a.source.splitlines()[0]  # the def line stays
         else:
             assert a.source == b.source, f"{path.name}: cell {i} changed"
 
 
 def test_the_assignment_runs_under_nbval_with_the_stubs(assignment):
     env = dict(os.environ, GEOMLIB_STRICT_CLAIMS="1", PYTHONPATH=str(ROOT))
-    cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--nbval-lax",
-           "--nbval-sanitize-with", str(ROOT / "tests" / "nbval_sanitize.cfg"),
-           "-c", str(assignment / "pytest.ini"), "--rootdir", str(assignment), str(assignment)]
+    cmd = [
+        sys.executable,
+        "-m",
+        "pytest",
+        "-q",
+        "-p",
+        "no:cacheprovider",
+        "--nbval-lax",
+        "--nbval-sanitize-with",
+        str(ROOT / "tests" / "nbval_sanitize.cfg"),
+        "-c",
+        str(assignment / "pytest.ini"),
+        "--rootdir",
+        str(assignment),
+        str(assignment),
+    ]
     (assignment / "pytest.ini").write_text("[pytest]\n")
     done = subprocess.run(cmd, cwd=assignment, env=env, capture_output=True, text=True, timeout=1500)
     assert done.returncode == 0, done.stdout[-6000:] + done.stderr[-2000:]

@@ -20,8 +20,10 @@ def _model(name, module="@jupyter-widgets/controls", **state):
 
 
 def _view(model_id, png=True):
-    data = {build_site.WIDGET_VIEW: {"version_major": 2, "version_minor": 0, "model_id": model_id},
-            "text/plain": "MeshView"}
+    data = {
+        build_site.WIDGET_VIEW: {"version_major": 2, "version_minor": 0, "model_id": model_id},
+        "text/plain": "MeshView",
+    }
     if png:
         data["image/png"] = "iVBORw0KGgo="
     return nbformat.v4.new_output("display_data", data=data)
@@ -39,8 +41,12 @@ def _notebook():
     }
     nb = nbformat.v4.new_notebook()
     nb.metadata["widgets"] = {build_site.WIDGET_STATE: {"version_major": 2, "version_minor": 0, "state": state}}
-    cells = [nbformat.v4.new_code_cell("box"), nbformat.v4.new_code_cell("view"),
-             nbformat.v4.new_code_cell("lost"), nbformat.v4.new_markdown_cell("# 03 · A title\n\ntext")]
+    cells = [
+        nbformat.v4.new_code_cell("box"),
+        nbformat.v4.new_code_cell("view"),
+        nbformat.v4.new_code_cell("lost"),
+        nbformat.v4.new_markdown_cell("# 03 · A title\n\ntext"),
+    ]
     cells[0].outputs = [_view("box")]
     cells[1].outputs = [_view("r2"), _view("label", png=False)]
     cells[2].outputs = [_view("gone")]
@@ -52,7 +58,7 @@ def test_controls_are_disabled_and_noted():
     nb, state = _notebook()
     assert build_site.prepare_for_site(nb) == 2
     assert state["slider"]["state"]["disabled"] is True
-    first = nb.cells[0].outputs       # view, its hidden still, the note
+    first = nb.cells[0].outputs  # view, its hidden still, the note
     assert len(first) == 3 and build_site.WIDGET_VIEW in first[0]["data"]
     assert 'class="site-still" hidden' in first[1]["data"]["text/html"]
     assert "base64,iVBORw0KGgo=" in first[1]["data"]["text/html"]
@@ -116,8 +122,9 @@ def test_every_package_is_pinned_exactly():
 def test_cell_errors_are_listed():
     nb = nbformat.v4.new_notebook()
     nb.cells = [nbformat.v4.new_markdown_cell("text"), nbformat.v4.new_code_cell("1 / 0")]
-    nb.cells[1].outputs = [nbformat.v4.new_output("error", ename="ZeroDivisionError",
-                                                  evalue="division by zero", traceback=[])]
+    nb.cells[1].outputs = [
+        nbformat.v4.new_output("error", ename="ZeroDivisionError", evalue="division by zero", traceback=[])
+    ]
     assert build_site.cell_errors(nb) == ["cell 1: ZeroDivisionError: division by zero"]
     nb.cells[1].outputs = []
     assert build_site.cell_errors(nb) == []

@@ -25,8 +25,7 @@ def cot_at(V, a, b, c):
     return u @ v / np.linalg.norm(np.cross(u, v))
 
 
-def learner_laplacian(V, F, angle="opposite", factor=0.5, diagonal=True, cot=cot_at, M_div=3.0, M_eye=False,
-                      sign=1.0):
+def learner_laplacian(V, F, angle="opposite", factor=0.5, diagonal=True, cot=cot_at, M_div=3.0, M_eye=False, sign=1.0):
     n = len(V)
     C = sp.lil_matrix((n, n))
     A = np.zeros(n)
@@ -131,8 +130,9 @@ def learner_mixed(V, F, rule="meyer"):
         obtuse = [c < 0 for c in cots]
         for c in range(3):
             i, j, k = f[c], f[(c + 1) % 3], f[(c + 2) % 3]
-            voronoi = (np.sum((V[i] - V[j]) ** 2) * cots[(c + 2) % 3]
-                       + np.sum((V[i] - V[k]) ** 2) * cots[(c + 1) % 3]) / 8
+            voronoi = (
+                np.sum((V[i] - V[j]) ** 2) * cots[(c + 2) % 3] + np.sum((V[i] - V[k]) ** 2) * cots[(c + 1) % 3]
+            ) / 8
             if rule == "barycentric":
                 A[i] += area / 3
             elif rule == "voronoi" or not any(obtuse):

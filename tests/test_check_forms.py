@@ -28,8 +28,7 @@ def forms(a, b, c, u, v):
     """The exercise as a learner writes it: unsimplified expressions."""
     p, p_u, p_v, m = parts(a, b, c, u, v)
     N = m / sp.sqrt(m.dot(m))
-    return (p_u.dot(p_u), p_u.dot(p_v), p_v.dot(p_v),
-            p.diff(u, 2).dot(N), p.diff(u, v).dot(N), p.diff(v, 2).dot(N))
+    return (p_u.dot(p_u), p_u.dot(p_v), p_v.dot(p_v), p.diff(u, 2).dot(N), p.diff(u, v).dot(N), p.diff(v, 2).dot(N))
 
 
 def as_matrices(a, b, c, u, v):
@@ -51,7 +50,10 @@ FORM_MISTAKES = {
     "unnormalised normal": (unnormalised, "normal is not normalised"),
     "outward normal": (lambda *x: forms(*x)[:3] + tuple(-y for y in forms(*x)[3:]), "sign of the normal is flipped"),
     "u and v swapped": (polar_u, "u and v are swapped"),
-    "E and G exchanged": (lambda *x: (forms(*x)[2], forms(*x)[1], forms(*x)[0]) + forms(*x)[3:], "E and G are exchanged"),
+    "E and G exchanged": (
+        lambda *x: (forms(*x)[2], forms(*x)[1], forms(*x)[0]) + forms(*x)[3:],
+        "E and G are exchanged",
+    ),
     "fresh symbols": (lambda a, b, c, u, v: forms(a, b, c, *sp.symbols("s t")), "other than a, b, c, u, v"),
     "three values": (lambda *x: forms(*x)[:3], "not (E, F, G, e, f, g) or (I, II)"),
 }
@@ -67,13 +69,14 @@ def test_forms_accept_reference_simplified_or_not():
         ell = ellipsoid(a, b, c)
         sub = {ell.u: u, ell.v: v}
         return ell.first_fundamental_form().subs(sub), ell.second_fundamental_form().subs(sub)
+
     assert check.fundamental_forms(library).passed
 
 
 def test_forms_check_is_quick():
     t0 = time.perf_counter()
     check.fundamental_forms(forms)
-    assert time.perf_counter() - t0 < 3.0       # generous on a busy machine; about 0.5 s when quiet
+    assert time.perf_counter() - t0 < 3.0  # generous on a busy machine; about 0.5 s when quiet
 
 
 @pytest.mark.parametrize("name", FORM_MISTAKES)
@@ -103,9 +106,14 @@ def kappa_sympy(a, b, c, phi):
 KAPPA_MISTAKES = {
     "phi from p_v": (lambda a, b, c, phi: kappa(a, b, c, phi + np.pi / 2), "measured from p_v instead of p_u"),
     "b and c swapped": (lambda a, b, c, phi: kappa(a, c, b, phi), "b and c are exchanged"),
-    "no division by I": (lambda a, b, c, phi: a * np.cos(phi) ** 2 + a * np.sin(phi) ** 2, "not divided by the first form"),
-    "parameter-plane angle": (lambda a, b, c, phi: a / (b**2 * np.cos(phi) ** 2 + c**2 * np.sin(phi) ** 2),
-                              "(u, v) parameter plane"),
+    "no division by I": (
+        lambda a, b, c, phi: a * np.cos(phi) ** 2 + a * np.sin(phi) ** 2,
+        "not divided by the first form",
+    ),
+    "parameter-plane angle": (
+        lambda a, b, c, phi: a / (b**2 * np.cos(phi) ** 2 + c**2 * np.sin(phi) ** 2),
+        "(u, v) parameter plane",
+    ),
     "sign": (lambda a, b, c, phi: -kappa(a, b, c, phi), "sign is flipped"),
     "symbolic leftover": (lambda a, b, c, phi: sp.Symbol("phi") * a, "not a number"),
 }

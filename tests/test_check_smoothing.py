@@ -10,7 +10,8 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from geomlib import check, explicit_step_limit as reference_limit_of_mesh, laplacian
+from geomlib import check, laplacian
+from geomlib import explicit_step_limit as reference_limit_of_mesh
 from geomlib.check import CheckFailed
 from geomlib.smoothing import explicit_step, implicit_step
 
@@ -44,6 +45,7 @@ STEP_MISTAKES = {
     "something else": (lambda P, M, C, tau: P + 0.5 * tau * (C @ P) / areas(M), "differ from P + tau M^-1 C P"),
 }
 
+
 def on_matrices(wrong):
     """A learner's fn(V, F) that builds (M, C) and then makes the mistake ``wrong(M, C)``."""
     return lambda V, F: wrong(*laplacian(V, F))
@@ -52,10 +54,14 @@ def on_matrices(wrong):
 LIMIT_MISTAKES = {
     "1/lam_max": (lambda M, C: reference_limit(M, C) / 2, "1 / lam_max, half the true one"),
     "eigenvalues of C": (lambda M, C: 2 / np.linalg.eigvalsh(-C.toarray())[-1], "from C instead of M^-1 C"),
-    "smallest non-zero": (lambda M, C: 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[1],
-                          "smallest non-zero eigenvalue"),
-    "smallest, zero": (lambda M, C: 2 / abs(scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[0]),
-                       "smallest eigenvalue (0, the constant mode)"),
+    "smallest non-zero": (
+        lambda M, C: 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[1],
+        "smallest non-zero eigenvalue",
+    ),
+    "smallest, zero": (
+        lambda M, C: 2 / abs(scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[0]),
+        "smallest eigenvalue (0, the constant mode)",
+    ),
     "sign": (lambda M, C: -reference_limit(M, C), "negative limit"),
     "lam_max itself": (lambda M, C: 2 / reference_limit(M, C), "returns lam_max"),
     "a vector": (lambda M, C: np.full(3, reference_limit(M, C)), "not one number"),
@@ -72,9 +78,12 @@ IMPLICIT_MISTAKES = {
 
 
 def test_references_pass_quickly():
-    for name, fn in (("explicit_step", explicit_step), ("explicit_step_limit", reference_limit_of_mesh),
-                     ("explicit_step_limit", on_matrices(reference_limit)),
-                     ("implicit_step", implicit_step)):
+    for name, fn in (
+        ("explicit_step", explicit_step),
+        ("explicit_step_limit", reference_limit_of_mesh),
+        ("explicit_step_limit", on_matrices(reference_limit)),
+        ("implicit_step", implicit_step),
+    ):
         start = time.perf_counter()
         result = getattr(check, name)(fn)
         assert result.passed, result.message
@@ -83,8 +92,9 @@ def test_references_pass_quickly():
 
 
 def test_the_equivalent_implicit_form_passes():
-    def with_delta(P, M, C, tau):            # (I - tau M^-1 C) P' = P is the same system divided by M
+    def with_delta(P, M, C, tau):  # (I - tau M^-1 C) P' = P is the same system divided by M
         return solve(sp.identity(len(P)) - tau * sp.diags(1 / M.diagonal()) @ C, P)
+
     assert check.implicit_step(with_delta).passed
 
 
@@ -119,7 +129,8 @@ def test_implicit_step_mistakes(name):
 def test_stubs_are_not_written_yet(name, monkeypatch):
     def stub(*args):
         raise NotImplementedError("Your turn")
-    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")      # a stub never raises, even under the tests
+
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")  # a stub never raises, even under the tests
     result = getattr(check, name)(stub)
     assert not result.passed and "not written yet" in result.message
 

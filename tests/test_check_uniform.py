@@ -26,10 +26,14 @@ def uniform(V, F):
 
 UNIFORM_MISTAKES = {
     "flipped sign": (lambda V, F: (uniform(V, F)[0], -uniform(V, F)[1]), "sign of C is flipped"),
-    "no diagonal": (lambda V, F: (uniform(V, F)[0], uniform(V, F)[1] - np.diag(uniform(V, F)[1].diagonal())),
-                    "diagonal of C is missing"),
-    "M^-1 C": (lambda V, F: (uniform(V, F)[0], uniform(V, F)[1] / uniform(V, F)[0].diagonal()[:, None]),
-               "M^-1 C, not C"),
+    "no diagonal": (
+        lambda V, F: (uniform(V, F)[0], uniform(V, F)[1] - np.diag(uniform(V, F)[1].diagonal())),
+        "diagonal of C is missing",
+    ),
+    "M^-1 C": (
+        lambda V, F: (uniform(V, F)[0], uniform(V, F)[1] / uniform(V, F)[0].diagonal()[:, None]),
+        "M^-1 C, not C",
+    ),
     "identity M": (lambda V, F: (np.eye(len(V)), uniform(V, F)[1]), "M is the identity"),
     "only C": (lambda V, F: uniform(V, F)[1], "not the pair (M, C)"),
 }
@@ -77,8 +81,10 @@ K_MISTAKES = {
     "degrees": (lambda V, F: np.degrees(gaussian_curvature(V, F)), "in degrees"),
     "integrated": (lambda V, F: gaussian_curvature(V, F, integrated=True), "not divided by the vertex area"),
     "mixed area": (lambda V, F: gaussian_curvature(V, F, area="mixed"), "mixed Voronoi area"),
-    "interior rule on the boundary": (lambda V, F: angle_deficit(V, F) / barycentric_areas(V, F),
-                                      "interior formula is applied at boundary vertices"),
+    "interior rule on the boundary": (
+        lambda V, F: angle_deficit(V, F) / barycentric_areas(V, F),
+        "interior formula is applied at boundary vertices",
+    ),
     "zero on the boundary": (lambda V, F: gaussian_curvature(V, F, boundary="zero"), "boundary vertices have a value"),
     "a matrix": (lambda V, F: np.diag(gaussian_curvature(V, F)), "expected (4,)"),
 }
@@ -93,6 +99,7 @@ def test_K_accepts_reference_and_written_solution():
 def test_mixed_and_barycentric_differ_on_the_check_mesh():
     # otherwise the "mixed area" diagnosis could not be told apart from a correct answer
     from geomlib.check.uniform import _TET_F, _TET_V
+
     assert not np.allclose(mixed_areas(_TET_V, _TET_F), barycentric_areas(_TET_V, _TET_F))
 
 
@@ -108,6 +115,6 @@ def test_K_stub_and_strict_mode(monkeypatch):
     result = check.gaussian_curvature(stub)
     assert not result.passed and "not written yet" in result.message
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
-    assert not check.gaussian_curvature(stub).passed          # a stub never raises
+    assert not check.gaussian_curvature(stub).passed  # a stub never raises
     with pytest.raises(CheckFailed, match="sign of the deficit"):
         check.gaussian_curvature(K_MISTAKES["sign"][0])

@@ -4,11 +4,18 @@ import warnings
 
 import numpy as np
 import pytest
-
-from geomlib import (MeshError, MeshWarning, gaussian_curvature, load_mesh, mean_curvature,
-                     principal_curvatures, surfaces)
-from geomlib.curvature import BOUNDARY_RULES, angle_sums, boundary_mask
 from meshdata import COURSE, COURSE_MESHES, SHIPPED, needs_course
+
+from geomlib import (
+    MeshError,
+    MeshWarning,
+    gaussian_curvature,
+    load_mesh,
+    mean_curvature,
+    principal_curvatures,
+    surfaces,
+)
+from geomlib.curvature import BOUNDARY_RULES, angle_sums, boundary_mask
 
 
 def euler_characteristic(V, F):
@@ -123,6 +130,7 @@ def test_gauss_bonnet_closed(name):
     for area in ("barycentric", "mixed"):
         K = gaussian_curvature(s.V, s.F, area=area)
         from geomlib import vertex_areas
+
         assert abs((K * vertex_areas(s.V, s.F, area)).sum() - 2 * np.pi * chi) < 1e-9
 
 
@@ -189,8 +197,9 @@ def test_rigid_motion_invariance(seed):
         b = mean_curvature(W, m.F, **kwargs)
         np.testing.assert_allclose(b, a, rtol=1e-9, atol=1e-12)
     for rule in BOUNDARY_RULES:
-        np.testing.assert_allclose(gaussian_curvature(W, m.F, boundary=rule),
-                                   gaussian_curvature(m.V, m.F, boundary=rule), rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(
+            gaussian_curvature(W, m.F, boundary=rule), gaussian_curvature(m.V, m.F, boundary=rule), rtol=1e-9, atol=1e-9
+        )
 
 
 def test_angle_sums_add_to_pi_per_triangle():
@@ -347,6 +356,7 @@ def test_boundary_detection_ignores_orientation_flips():
 
 # ---------------------------------------------------------------- the teaching functions one by one
 
+
 def test_corner_angles_and_angle_deficit_against_libigl():
     from geomlib.curvature import angle_deficit, corner_angles
 
@@ -363,7 +373,7 @@ def test_corner_angles_of_a_3_4_5_triangle_and_a_collinear_one():
     np.testing.assert_allclose(theta, [[np.pi / 2, np.arctan2(3, 4), np.arctan2(4, 3)]], atol=1e-15)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MeshWarning)
-        flat = corner_angles(V, [[0, 1, 3]])          # zero area: pi opposite the longest edge (0, 3)
+        flat = corner_angles(V, [[0, 1, 3]])  # zero area: pi opposite the longest edge (0, 3)
     assert flat.tolist() == [[0.0, np.pi, 0.0]]
 
 

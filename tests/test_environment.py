@@ -22,8 +22,16 @@ from packaging.specifiers import SpecifierSet
 from packaging.utils import canonicalize_name
 
 ROOT = Path(__file__).resolve().parents[1]
-FRONT_END = {"jupyterlab", "notebook", "ipykernel", "ipywidgets", "jupyterlab-widgets",
-             "widgetsnbextension", "pythreejs", "ipydatawidgets"}
+FRONT_END = {
+    "jupyterlab",
+    "notebook",
+    "ipykernel",
+    "ipywidgets",
+    "jupyterlab-widgets",
+    "widgetsnbextension",
+    "pythreejs",
+    "ipydatawidgets",
+}
 # packages the front-end installs that must not be pinned by geomlib's own requirements
 NOT_REQUIRED = {"jupyterlab", "notebook", "ipykernel", "jupyterlab-widgets", "widgetsnbextension"}
 # what environment.yml may ask conda for: conda-forge packages of exactly these names
@@ -71,14 +79,16 @@ def _workbook():
 
 def test_package_requirements_are_ranges_without_the_front_end():
     required = _requirements(_project()["dependencies"])
-    pinned = {name: str(r.specifier) for name, r in required.items()
-              if any(s.operator in ("==", "===") for s in r.specifier)}
+    pinned = {
+        name: str(r.specifier) for name, r in required.items() if any(s.operator in ("==", "===") for s in r.specifier)
+    }
     assert not pinned, f"exact pins in [project] dependencies (they belong in constraints.txt): {pinned}"
     unbounded = [name for name, r in required.items() if not any(s.operator == "<" for s in r.specifier)]
     assert not unbounded, f"give these an upper bound (next major release): {unbounded}"
     assert not NOT_REQUIRED & set(required), (
         f"the package requires front-end packages {sorted(NOT_REQUIRED & set(required))}; "
-        "they belong in the 'lab' extra")
+        "they belong in the 'lab' extra"
+    )
     # what the notebooks import for the views must still come with the package
     assert {"ipywidgets", "pythreejs"} <= set(required)
 
@@ -92,7 +102,8 @@ def test_constraints_pin_every_declared_package_inside_its_range():
     for name, req in _requirements(declared).items():
         assert name in pins, f"{name} is declared in pyproject.toml but not pinned in constraints.txt"
         assert req.specifier.contains(pins[name], prereleases=True), (
-            f"{name}=={pins[name]} in constraints.txt is outside {req.specifier} from pyproject.toml")
+            f"{name}=={pins[name]} in constraints.txt is outside {req.specifier} from pyproject.toml"
+        )
 
 
 def test_lab_extra_pins_the_front_end_as_constraints_do():
@@ -103,7 +114,8 @@ def test_lab_extra_pins_the_front_end_as_constraints_do():
     for name, req in lab.items():
         (spec,) = list(req.specifier)
         assert spec.operator == "==" and spec.version == pins[name], (
-            f"geomlib[lab] asks for {name}{req.specifier}, constraints.txt pins {pins[name]}")
+            f"geomlib[lab] asks for {name}{req.specifier}, constraints.txt pins {pins[name]}"
+        )
 
 
 def test_environment_yml_asks_conda_only_for_python_and_pip():

@@ -18,8 +18,7 @@ def test_factors_at_known_points():
     np.testing.assert_allclose(mode_factor(lam, tau, "implicit"), [1.0, 2 / 3, 0.5, 1 / 3])
     np.testing.assert_allclose(mode_factor(lam, tau, "crank-nicolson"), [1.0, 0.6, 1 / 3, 0.0])
     np.testing.assert_allclose(mode_factor(lam, tau, "diffusion"), np.exp(-tau * lam))
-    np.testing.assert_allclose(mode_factor(lam, tau, "taubin", tau_inflate=-0.6),
-                               (1 - 0.5 * lam) * (1 + 0.6 * lam))
+    np.testing.assert_allclose(mode_factor(lam, tau, "taubin", tau_inflate=-0.6), (1 - 0.5 * lam) * (1 + 0.6 * lam))
 
 
 def test_implicit_is_weaker_than_diffusion_and_explicit_stronger():
@@ -34,7 +33,7 @@ def test_implicit_is_weaker_than_diffusion_and_explicit_stronger():
 def test_taubin_keeps_low_frequencies_and_needs_its_signs():
     lam = np.array([0.0, 1e-3])
     f = mode_factor(lam, 0.5, "taubin", tau_inflate=-0.53)
-    assert f[0] == 1.0 and f[1] > 1.0 - 1e-4                 # the pass band is (nearly) untouched
+    assert f[0] == 1.0 and f[1] > 1.0 - 1e-4  # the pass band is (nearly) untouched
     with pytest.raises(ValueError, match="tau_inflate < 0"):
         mode_factor(lam, 0.5, "taubin", tau_inflate=0.5)
     with pytest.raises(ValueError, match="scheme must be one of"):

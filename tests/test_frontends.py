@@ -20,15 +20,15 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 
-STAND_IN_OUTPUT = '''
+STAND_IN_OUTPUT = """
 CALLS = []
 
 def enable_custom_widget_manager(*args, **kwargs):
     CALLS.append((args, kwargs))
-'''
+"""
 
 # runs the set-up cell twice, as a reader who re-runs it does, then reports
-RUNNER = textwrap.dedent('''
+RUNNER = textwrap.dedent("""
     import json, sys
     from IPython.terminal.interactiveshell import TerminalInteractiveShell as InteractiveShell
     shell = InteractiveShell.instance()
@@ -40,7 +40,7 @@ RUNNER = textwrap.dedent('''
     output = sys.modules.get("google.colab.output")
     print(json.dumps({"colab_imported": "google.colab" in sys.modules,
                       "calls": None if output is None else len(output.CALLS)}))
-''')
+""")
 
 
 def setup_cell(notebook):
@@ -57,8 +57,14 @@ def run_setup_cell(tmp_path, source, site):
     cell = tmp_path / "setup_cell.py"
     cell.write_text(source, encoding="utf-8")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), str(ROOT)]), MPLBACKEND="agg")
-    done = subprocess.run([sys.executable, "-c", RUNNER, str(cell)], cwd=ROOT / "notebooks", env=env,
-                          capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", RUNNER, str(cell)],
+        cwd=ROOT / "notebooks",
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr[-3000:]
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -69,7 +75,8 @@ def test_every_notebook_imports_geomlib_in_its_first_code_cell():
         first = next(c for c in cells if c["cell_type"] == "code")
         assert "import geomlib" in "".join(first["source"]), (
             f"{notebook.name}: the first code cell does not import geomlib, so in Colab the 3D views "
-            "would appear before the custom widget manager is enabled")
+            "would appear before the custom widget manager is enabled"
+        )
 
 
 @pytest.mark.slow

@@ -28,7 +28,6 @@ NOTEBOOK = ROOT / "notebooks" / "00_getting_started.ipynb"
 WIDGET = "application/vnd.jupyter.widget-view+json"
 
 
-
 def test_box_still_draws_the_views_inside_a_box_and_nothing_else():
     from geomlib import surfaces
     from geomlib.viewer import MeshView, box_still, side_by_side
@@ -56,7 +55,8 @@ def test_html_export_without_widget_state_shows_a_still_for_every_view(monkeypat
     monkeypatch.setenv("PYTHONPATH", str(ROOT))
     nb = nbformat.read(NOTEBOOK, as_version=4)
     ExecutePreprocessor(timeout=600, store_widget_state=True).preprocess(
-        nb, {"metadata": {"path": str(NOTEBOOK.parent)}})
+        nb, {"metadata": {"path": str(NOTEBOOK.parent)}}
+    )
     state = nb.metadata.pop("widgets")["application/vnd.jupyter.widget-state+json"]["state"]
 
     views = stills = images = 0

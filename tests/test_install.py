@@ -52,7 +52,7 @@ def _freeze(python):
     versions = {}
     for line in out.stdout.splitlines():
         if line.startswith(("#", "-e ")):
-            continue                       # editable installs: geomlib itself
+            continue  # editable installs: geomlib itself
         name, sep, version = line.partition("==") if "==" in line else line.partition(" @ ")
         versions[canonicalize_name(name)] = version
     return versions
@@ -74,10 +74,15 @@ def test_installing_geomlib_keeps_an_existing_jupyterlab_4(tmp_path):
     bindir = home / ("Scripts" if os.name == "nt" else "bin")
     python = bindir / ("python.exe" if os.name == "nt" else "python")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "JUPYTER_PATH", "VIRTUAL_ENV")}
-    env.update(PATH=os.pathsep.join([str(bindir), env.get("PATH", "")]), PYTHONNOUSERSITE="1",
-               JUPYTER_PREFER_ENV_PATH="1", JUPYTER_DATA_DIR=str(tmp_path / "jupyter-data"),
-               JUPYTER_CONFIG_DIR=str(tmp_path / "jupyter-config"), GEOMLIB_STRICT_CLAIMS="1",
-               PIP_DISABLE_PIP_VERSION_CHECK="1")
+    env.update(
+        PATH=os.pathsep.join([str(bindir), env.get("PATH", "")]),
+        PYTHONNOUSERSITE="1",
+        JUPYTER_PREFER_ENV_PATH="1",
+        JUPYTER_DATA_DIR=str(tmp_path / "jupyter-data"),
+        JUPYTER_CONFIG_DIR=str(tmp_path / "jupyter-config"),
+        GEOMLIB_STRICT_CLAIMS="1",
+        PIP_DISABLE_PIP_VERSION_CHECK="1",
+    )
     seconds = {}
 
     t0 = time.perf_counter()
@@ -96,24 +101,38 @@ def test_installing_geomlib_keeps_an_existing_jupyterlab_4(tmp_path):
     added = sorted(f"{name}=={after[name]}" for name in after if name not in before)
 
     t0 = time.perf_counter()
-    nbval = subprocess.run([python, "-m", "pytest", NOTEBOOK, "-q", "-p", "no:cacheprovider"], cwd=ROOT, env=env,
-                           capture_output=True, text=True, timeout=600)
+    nbval = subprocess.run(
+        [python, "-m", "pytest", NOTEBOOK, "-q", "-p", "no:cacheprovider"],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     seconds["nbval notebook 00"] = time.perf_counter() - t0
 
     report = ROOT / "build" / "install-test.txt"
     report.parent.mkdir(exist_ok=True)
-    report.write_text("\n".join([
-        f"Python {sys.version.split()[0]}",
-        "existing front-end (unchanged by pip: {}): {}".format(
-            not changed, ", ".join(f"{n}=={v}" for n, v in EXISTING.items())),
-        f"packages pip changed: {moved or 'none'}",
-        f"packages pip added with geomlib: {', '.join(added)}",
-        *(f"{what}: {s:.1f} s" for what, s in seconds.items()),
-        f"nbval: {nbval.stdout.strip().splitlines()[-1] if nbval.stdout.strip() else nbval.stderr[-500:]}",
-    ]) + "\n")
+    report.write_text(
+        "\n".join(
+            [
+                f"Python {sys.version.split()[0]}",
+                "existing front-end (unchanged by pip: {}): {}".format(
+                    not changed, ", ".join(f"{n}=={v}" for n, v in EXISTING.items())
+                ),
+                f"packages pip changed: {moved or 'none'}",
+                f"packages pip added with geomlib: {', '.join(added)}",
+                *(f"{what}: {s:.1f} s" for what, s in seconds.items()),
+                f"nbval: {nbval.stdout.strip().splitlines()[-1] if nbval.stdout.strip() else nbval.stderr[-500:]}",
+            ]
+        )
+        + "\n"
+    )
 
     assert not changed, f"installing geomlib changed the front-end (before, after): {changed}"
     assert not moved, f"installing geomlib changed packages that were there (before, after): {moved}"
     where = _run([python, "-c", "import geomlib; print(geomlib.__file__)"], env, cwd=tmp_path)
     assert Path(where.stdout.strip()).parent == ROOT / "geomlib", f"geomlib imported from {where.stdout}"
-    assert nbval.returncode == 0, f"{NOTEBOOK} failed under nbval there:\n{nbval.stdout[-4000:]}\n{nbval.stderr[-2000:]}"
+    assert nbval.returncode == 0, (
+        f"{NOTEBOOK} failed under nbval there:\n{nbval.stdout[-4000:]}\n{nbval.stderr[-2000:]}"
+    )

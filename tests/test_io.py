@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from meshdata import COURSE, needs_course
 
 from geomlib import MeshError, MeshReport, MeshWarning, load_mesh, save_mesh
-from meshdata import COURSE, needs_course
 
 
 def write(tmp_path, name, text):
@@ -52,9 +52,13 @@ SQUARE_V = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
     ],
 )
 def test_obj_face_syntax(tmp_path, faces):
-    text = ("# a unit square\nmtllib square.mtl\no square\n" + SQUARE_V
-            + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n"
-            + "g top\nusemtl paper\ns off\n" + faces)
+    text = (
+        "# a unit square\nmtllib square.mtl\no square\n"
+        + SQUARE_V
+        + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n"
+        + "g top\nusemtl paper\ns off\n"
+        + faces
+    )
     V, F = load_quiet(write(tmp_path, "sq.obj", text))
     assert V.dtype == np.float64 and F.dtype == np.int64
     assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
@@ -74,8 +78,7 @@ def test_obj_relative_indices_refer_to_vertices_above(tmp_path):
 
 
 def test_obj_vertex_extras_crlf_continuation_and_blanks(tmp_path):
-    text = ("v 0 0 0 1.0\r\nv 1 0 0 0.5 0.5 0.5\r\n  v 0 1 0\r\n\r\n"
-            "f 1 2 \\\r\n 3  # a comment\r\n")
+    text = "v 0 0 0 1.0\r\nv 1 0 0 0.5 0.5 0.5\r\n  v 0 1 0\r\n\r\nf 1 2 \\\r\n 3  # a comment\r\n"
     V, F = load_quiet(write(tmp_path, "odd.obj", text))
     assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [0, 1, 0]])
     assert np.array_equal(F, [[0, 1, 2]])
@@ -125,7 +128,9 @@ def test_windows_scanner_file_loads_as_written(tmp_path):
 
 
 def test_bom_alone_and_classic_mac_line_ends(tmp_path):
-    V, F = load_quiet(write(tmp_path, "mac.obj", b"\xef\xbb\xbf" + (SQUARE_V + "f 1 2 3\nf 1 3 4").replace("\n", "\r").encode()))
+    V, F = load_quiet(
+        write(tmp_path, "mac.obj", b"\xef\xbb\xbf" + (SQUARE_V + "f 1 2 3\nf 1 3 4").replace("\n", "\r").encode())
+    )
     assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]) and np.array_equal(F, [[0, 1, 2], [0, 2, 3]])
 
 
@@ -262,7 +267,9 @@ def test_unreadable_file(tmp_path, monkeypatch):
 
 
 def test_unknown_extension(tmp_path):
-    expect(write(tmp_path, "mesh.xyz", SQUARE_V), r": unknown mesh format '\.xyz'; supported: \.obj, \.off, \.ply, \.stl$")
+    expect(
+        write(tmp_path, "mesh.xyz", SQUARE_V), r": unknown mesh format '\.xyz'; supported: \.obj, \.off, \.ply, \.stl$"
+    )
     expect(write(tmp_path, "mesh", SQUARE_V), r": unknown mesh format '\(no extension\)'")
 
 
@@ -286,8 +293,10 @@ def test_faces_but_no_vertices(tmp_path):
 
 def test_nan_and_inf_coordinates(tmp_path):
     text = "v 0 0 0\nv nan 0 0\nv 0 1 0\nv 0 0 inf\nf 1 2 3\nf 1 3 4\n"
-    expect(write(tmp_path, "nan.obj", text),
-           r": 2 vertices have NaN or infinite coordinates: vertices 1, 3 \(0-based; lines 2, 4\)$")
+    expect(
+        write(tmp_path, "nan.obj", text),
+        r": 2 vertices have NaN or infinite coordinates: vertices 1, 3 \(0-based; lines 2, 4\)$",
+    )
 
 
 def test_face_index_out_of_range(tmp_path):
@@ -300,49 +309,70 @@ def test_face_index_out_of_range(tmp_path):
 
 def test_negative_index_out_of_range(tmp_path):
     text = "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n"  # only 2 vertices above the face
-    expect(write(tmp_path, "neg.obj", text), r"out of range, the file has 3 vertices .*: line 3 \(face 0\): index -3; 1 face on line 3$")
+    expect(
+        write(tmp_path, "neg.obj", text),
+        r"out of range, the file has 3 vertices .*: line 3 \(face 0\): index -3; 1 face on line 3$",
+    )
 
 
 def test_index_zero(tmp_path):
-    expect(write(tmp_path, "zero.obj", SQUARE_V + "f 1 2 3\nf 0 1 2\n"),
-           r": line 6: vertex index 0 is invalid \(OBJ indices start at 1\)$")
+    expect(
+        write(tmp_path, "zero.obj", SQUARE_V + "f 1 2 3\nf 0 1 2\n"),
+        r": line 6: vertex index 0 is invalid \(OBJ indices start at 1\)$",
+    )
 
 
 def test_face_repeating_a_vertex(tmp_path):
-    expect(write(tmp_path, "rep.obj", SQUARE_V + "f 1 2 3\nf 3 4 3\n"),
-           r": 1 face repeats a vertex \(no triangle; 0-based vertex indices\): line 6: face 1 = \[2, 3, 2\]$")
+    expect(
+        write(tmp_path, "rep.obj", SQUARE_V + "f 1 2 3\nf 3 4 3\n"),
+        r": 1 face repeats a vertex \(no triangle; 0-based vertex indices\): line 6: face 1 = \[2, 3, 2\]$",
+    )
     # a pentagon listing a corner twice in a row (its fan has a degenerate triangle), and a bad triangle
-    msg = expect(write(tmp_path, "rep2.obj", SQUARE_V + "f 1 2 3 3 4\nf 4 4 1\n"),
-                 r": 2 faces repeat a vertex .*: line 5: face 1 = \[0, 2, 2\]; line 6: face 3 = \[3, 3, 0\]")
+    msg = expect(
+        write(tmp_path, "rep2.obj", SQUARE_V + "f 1 2 3 3 4\nf 4 4 1\n"),
+        r": 2 faces repeat a vertex .*: line 5: face 1 = \[0, 2, 2\]; line 6: face 3 = \[3, 3, 0\]",
+    )
     assert msg.endswith("faces 1, 3 on lines 5, 6")
 
 
 def test_malformed_vertex_line(tmp_path):
-    expect(write(tmp_path, "badv.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n"),
-           r": line 2: vertex coordinates are not numbers: 'v 1 zero 0'$")
-    expect(write(tmp_path, "shortv.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n"),
-           r": line 2: a vertex needs x y z \(optionally w or r g b\), found 2 numbers: 'v 1 0'$")
+    expect(
+        write(tmp_path, "badv.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n"),
+        r": line 2: vertex coordinates are not numbers: 'v 1 zero 0'$",
+    )
+    expect(
+        write(tmp_path, "shortv.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n"),
+        r": line 2: a vertex needs x y z \(optionally w or r g b\), found 2 numbers: 'v 1 0'$",
+    )
 
 
 def test_malformed_face_line(tmp_path):
-    expect(write(tmp_path, "badf.obj", SQUARE_V + "f 1 2 3\nf 1 2 x\n"),
-           r": line 6: face corners must be integers \(v, v/vt, v//vn or v/vt/vn\): 'f 1 2 x'$")
+    expect(
+        write(tmp_path, "badf.obj", SQUARE_V + "f 1 2 3\nf 1 2 x\n"),
+        r": line 6: face corners must be integers \(v, v/vt, v//vn or v/vt/vn\): 'f 1 2 x'$",
+    )
     expect(write(tmp_path, "floatf.obj", SQUARE_V + "f 1 2 3.5\n"), r": line 5: face corners must be integers")
 
 
 def test_face_index_too_large(tmp_path):
-    expect(write(tmp_path, "big.obj", SQUARE_V + "f 1 2 123456789012345678901234567890\n"),
-           r": line 5: face index too large: 'f 1 2 123456789012345678901234567890'$")
+    expect(
+        write(tmp_path, "big.obj", SQUARE_V + "f 1 2 123456789012345678901234567890\n"),
+        r": line 5: face index too large: 'f 1 2 123456789012345678901234567890'$",
+    )
 
 
 def test_face_with_two_vertices(tmp_path):
-    expect(write(tmp_path, "two.obj", SQUARE_V + "f 1 2 3\nf 1 2\n"),
-           r": line 6: a face needs at least 3 vertex indices, found 2$")
+    expect(
+        write(tmp_path, "two.obj", SQUARE_V + "f 1 2 3\nf 1 2\n"),
+        r": line 6: a face needs at least 3 vertex indices, found 2$",
+    )
 
 
 def test_unknown_statement(tmp_path):
-    expect(write(tmp_path, "junk.obj", SQUARE_V + "hello world\nf 1 2 3\n"),
-           r": line 5: not an OBJ statement \(expected v, f, vn, vt, o, g, s, usemtl, mtllib or a # comment\): 'hello world'$")
+    expect(
+        write(tmp_path, "junk.obj", SQUARE_V + "hello world\nf 1 2 3\n"),
+        r": line 5: not an OBJ statement \(expected v, f, vn, vt, o, g, s, usemtl, mtllib or a # comment\): 'hello world'$",
+    )
 
 
 def test_binary_garbage_named_obj(tmp_path):
@@ -353,8 +383,10 @@ def test_binary_garbage_named_obj(tmp_path):
 
 
 def test_off_reader_polygons_comments_and_colours(tmp_path):
-    text = ("OFF\n# a square and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0 0.5 0.5 0.5\n0 0 1\n"
-            "4 0 1 2 3 255 0 0\n3 0 4 1\n")
+    text = (
+        "OFF\n# a square and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0 0.5 0.5 0.5\n0 0 1\n"
+        "4 0 1 2 3 255 0 0\n3 0 4 1\n"
+    )
     V, F, rep = load_mesh(write(tmp_path, "sq.off", text), report=True)
     assert len(V) == 5 and np.array_equal(F, [[0, 1, 2], [0, 2, 3], [0, 4, 1]])
     V2, F2, _ = load_mesh(write(tmp_path, "sq2.off", "OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), report=True)
@@ -362,32 +394,44 @@ def test_off_reader_polygons_comments_and_colours(tmp_path):
 
 
 def test_off_bad_header(tmp_path):
-    expect(write(tmp_path, "h.off", "OFF\nthree 1 0\n0 0 0\n"),
-           r": line 2: expected the counts 'nv nf ne' of the OFF header, found 'three 1 0'$")
+    expect(
+        write(tmp_path, "h.off", "OFF\nthree 1 0\n0 0 0\n"),
+        r": line 2: expected the counts 'nv nf ne' of the OFF header, found 'three 1 0'$",
+    )
 
 
 def test_off_truncated(tmp_path):
-    expect(write(tmp_path, "t.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n"),
-           r": the header \(line 2\) announces 4 vertices and 2 faces, but the file ends after 4 vertex lines and 1 face line$")
+    expect(
+        write(tmp_path, "t.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n"),
+        r": the header \(line 2\) announces 4 vertices and 2 faces, but the file ends after 4 vertex lines and 1 face line$",
+    )
 
 
 def test_off_malformed_lines(tmp_path):
-    expect(write(tmp_path, "v.off", "OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n"),
-           r": line 4: a vertex needs 3 numbers x y z, found '1 0'$")
-    expect(write(tmp_path, "f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n"),
-           r": line 6: a face is 'k i0 ... ik-1' with k integer indices, found '4 0 1 2'$")
+    expect(
+        write(tmp_path, "v.off", "OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n"),
+        r": line 4: a vertex needs 3 numbers x y z, found '1 0'$",
+    )
+    expect(
+        write(tmp_path, "f.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n"),
+        r": line 6: a face is 'k i0 ... ik-1' with k integer indices, found '4 0 1 2'$",
+    )
 
 
 def test_off_index_out_of_range(tmp_path):
-    msg = expect(write(tmp_path, "r.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"),
-                 r": face indices out of range, the file has 3 vertices \(valid: 0..2\): line 7 \(face 1\): index 3")
+    msg = expect(
+        write(tmp_path, "r.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"),
+        r": face indices out of range, the file has 3 vertices \(valid: 0..2\): line 7 \(face 1\): index 3",
+    )
     assert msg.endswith("1 face on line 7")
 
 
 def test_off_vertices_but_no_faces_and_nan(tmp_path):
     expect(write(tmp_path, "p.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), r": the file has 3 vertices but no faces")
-    expect(write(tmp_path, "n.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
-           r": 1 vertex has NaN or infinite coordinates: vertices 1 \(0-based; lines 4\)$")
+    expect(
+        write(tmp_path, "n.off", "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
+        r": 1 vertex has NaN or infinite coordinates: vertices 1 \(0-based; lines 4\)$",
+    )
 
 
 def test_off_binary_refused(tmp_path):
@@ -395,7 +439,10 @@ def test_off_binary_refused(tmp_path):
 
 
 def test_ply_and_stl_garbage(tmp_path):
-    expect(write(tmp_path, "g.ply", b"this is not a ply file\n"), r": not a PLY file: it does not start with the line 'ply'$")
+    expect(
+        write(tmp_path, "g.ply", b"this is not a ply file\n"),
+        r": not a PLY file: it does not start with the line 'ply'$",
+    )
     expect(write(tmp_path, "h.ply", b"ply\nformat ascii 1.0\nelement vertex x\n"), r": cannot read as PLY: ")
     expect(write(tmp_path, "g.stl", b"solid x\nfacet what\n"), r": cannot read as STL: ")
 
@@ -403,10 +450,14 @@ def test_ply_and_stl_garbage(tmp_path):
 def test_ply_out_of_range_and_nan(tmp_path):
     head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
     head += "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-    expect(write(tmp_path, "r.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"),
-           r"face indices out of range \(valid: 0..2 for 3 vertices\): face 0 has index 5")
-    expect(write(tmp_path, "n.ply", head + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
-           r"1 vertex has NaN or infinite coordinates: vertices 1 \(0-based\)$")
+    expect(
+        write(tmp_path, "r.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n"),
+        r"face indices out of range \(valid: 0..2 for 3 vertices\): face 0 has index 5",
+    )
+    expect(
+        write(tmp_path, "n.ply", head + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n"),
+        r"1 vertex has NaN or infinite coordinates: vertices 1 \(0-based\)$",
+    )
 
 
 def test_ply_vertices_but_no_faces(tmp_path):

@@ -6,11 +6,17 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import trimesh
-
-from geomlib import MeshError, MeshWarning, cotangent_weights, laplacian, load_mesh, vertex_areas
-from geomlib import surfaces
 from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, needs_course
 
+from geomlib import MeshError, MeshWarning, cotangent_weights, laplacian, load_mesh, surfaces, vertex_areas
+from geomlib.laplace import (
+    barycentric_areas,
+    cotangent_matrix,
+    face_geometry,
+    mixed_areas,  # noqa: E402
+    uniform_adjacency,
+    uniform_laplacian,
+)
 
 AREAS = ("barycentric", "mixed")
 
@@ -40,9 +46,7 @@ def test_right_triangle_cotan_entries():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
     F = np.array([[0, 1, 2]])
     M, C = laplacian(V, F)
-    expected = np.array([[-1.0, 0.5, 0.5],
-                         [0.5, -0.5, 0.0],
-                         [0.5, 0.0, -0.5]])
+    expected = np.array([[-1.0, 0.5, 0.5], [0.5, -0.5, 0.0], [0.5, 0.0, -0.5]])
     np.testing.assert_allclose(dense(C), expected, atol=1e-15)
     np.testing.assert_allclose(M.diagonal(), [1 / 6, 1 / 6, 1 / 6], atol=1e-15)
     # right triangle is not obtuse: Voronoi areas 1/4 at the right angle, 1/8 at the others
@@ -178,19 +182,31 @@ def test_rigid_motion_invariance(seed):
 def _mesh_with_bad_triangles():
     """A flat fan plus a zero-area triangle (collinear), a near-collinear needle,
     a triangle with two coincident vertices and an isolated vertex."""
-    V = np.array([
-        [0.0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0],  # 0-4: a fan
-        [2.0, 0, 0], [3.0, 0, 0],                                   # 5, 6: collinear with 1
-        [1.0, 1e-9, 0],                                              # 7: needle apex
-        [0.0, 1.0, 0],                                               # 8: coincides with 2
-        [9.0, 9.0, 9.0],                                             # 9: isolated
-    ])
-    F = np.array([
-        [0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1],
-        [1, 5, 6],   # zero area (collinear)
-        [3, 1, 7],   # needle: height 1e-9 over a base of length 2
-        [0, 2, 8],   # zero area (2 and 8 coincide)
-    ])
+    V = np.array(
+        [
+            [0.0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [-1, 0, 0],
+            [0, -1, 0],  # 0-4: a fan
+            [2.0, 0, 0],
+            [3.0, 0, 0],  # 5, 6: collinear with 1
+            [1.0, 1e-9, 0],  # 7: needle apex
+            [0.0, 1.0, 0],  # 8: coincides with 2
+            [9.0, 9.0, 9.0],  # 9: isolated
+        ]
+    )
+    F = np.array(
+        [
+            [0, 1, 2],
+            [0, 2, 3],
+            [0, 3, 4],
+            [0, 4, 1],
+            [1, 5, 6],  # zero area (collinear)
+            [3, 1, 7],  # needle: height 1e-9 over a base of length 2
+            [0, 2, 8],  # zero area (2 and 8 coincide)
+        ]
+    )
     return V, F
 
 
@@ -294,16 +310,13 @@ def test_libigl_course_meshes(name):
 
 # ---------------------------------------------------------------- the teaching functions one by one
 
-from geomlib.laplace import (barycentric_areas, cotangent_matrix, face_geometry, mixed_areas,  # noqa: E402
-                             uniform_adjacency, uniform_laplacian)
-
 
 def test_face_geometry_of_a_3_4_5_triangle():
     V = np.array([[0.0, 0, 0], [4, 0, 0], [0, 3, 0]])
     l2, dblA, cot, degenerate = face_geometry(V, [[0, 1, 2]])
-    assert l2.tolist() == [[25.0, 9.0, 16.0]]          # opposite corners 0, 1, 2
+    assert l2.tolist() == [[25.0, 9.0, 16.0]]  # opposite corners 0, 1, 2
     assert dblA.tolist() == [12.0] and not degenerate[0]
-    np.testing.assert_allclose(cot, [[0.0, 4 / 3, 3 / 4]], atol=1e-15)   # right angle at 0; cot = adjacent / opposite
+    np.testing.assert_allclose(cot, [[0.0, 4 / 3, 3 / 4]], atol=1e-15)  # right angle at 0; cot = adjacent / opposite
 
 
 def test_each_teaching_function_equals_the_dispatcher():
@@ -350,7 +363,9 @@ def test_teaching_functions_against_libigl_one_by_one():
     V, F = icosphere(3, scale=(1.0, 0.7, 0.4))
     scale = np.abs(igl.cotmatrix(V, F)).max()
     assert abs(cotangent_matrix(V, F) - igl.cotmatrix(V, F)).max() < 1e-12 * scale
-    np.testing.assert_allclose(barycentric_areas(V, F),
-                               igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal(), rtol=1e-12)
-    np.testing.assert_allclose(mixed_areas(V, F), igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal(),
-                               rtol=1e-12)
+    np.testing.assert_allclose(
+        barycentric_areas(V, F), igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal(), rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        mixed_areas(V, F), igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal(), rtol=1e-12
+    )

@@ -15,12 +15,29 @@ from geomlib import surfaces
 ROOT = Path(__file__).resolve().parents[1]
 MESHES = ROOT / "meshes"
 NAMES = [
-    "plane.obj", "plane_irregular.obj", "plane_noisy.obj", "saddle.obj", "sphere.obj",
-    "ellipsoid.obj", "ellipsoid_jittered.obj", "torus.obj", "creature.obj",
-    "cad_part.obj", "cad_part_noisy.obj", "cube.obj",
+    "plane.obj",
+    "plane_irregular.obj",
+    "plane_noisy.obj",
+    "saddle.obj",
+    "sphere.obj",
+    "ellipsoid.obj",
+    "ellipsoid_jittered.obj",
+    "torus.obj",
+    "creature.obj",
+    "cad_part.obj",
+    "cad_part_noisy.obj",
+    "cube.obj",
 ]
-CLOSED = {"sphere.obj", "ellipsoid.obj", "ellipsoid_jittered.obj", "torus.obj", "creature.obj",
-          "cad_part.obj", "cad_part_noisy.obj", "cube.obj"}
+CLOSED = {
+    "sphere.obj",
+    "ellipsoid.obj",
+    "ellipsoid_jittered.obj",
+    "torus.obj",
+    "creature.obj",
+    "cad_part.obj",
+    "cad_part_noisy.obj",
+    "cube.obj",
+}
 
 
 def _load_generator():

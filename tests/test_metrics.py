@@ -56,6 +56,7 @@ def cube():
 
 # --- identical meshes -------------------------------------------------------
 
+
 def test_identical_meshes_give_zero_everywhere():
     V, F = icosphere(2)
     out = denoising_metrics(V.copy(), V, F)
@@ -68,6 +69,7 @@ def test_identical_meshes_give_zero_everywhere():
 
 
 # --- vertex RMS -----------------------------------------------------------
+
 
 def test_translated_copy_has_rms_equal_to_the_shift():
     V, F = icosphere(2)
@@ -96,11 +98,13 @@ def test_relative_metrics_do_not_depend_on_units_or_position():
     for key in ("normal_mean", "normal_p95", "area_change", "volume_change"):
         assert c[key] == pytest.approx(a[key], rel=1e-6, abs=1e-12), key
     assert vertex_rms(W @ R.T, V @ R.T, relative=False) == pytest.approx(vertex_rms(W, V, relative=False))
-    assert (hausdorff_distance(W @ R.T, V @ R.T, F, relative=False)
-            == pytest.approx(hausdorff_distance(W, V, F, relative=False), rel=1e-9))
+    assert hausdorff_distance(W @ R.T, V @ R.T, F, relative=False) == pytest.approx(
+        hausdorff_distance(W, V, F, relative=False), rel=1e-9
+    )
 
 
 # --- normals -----------------------------------------------------------
+
 
 @pytest.mark.parametrize("degrees", [0.5, 10.0, 37.0, 120.0])
 def test_rotated_patch_has_every_normal_off_by_the_angle(degrees):
@@ -156,6 +160,7 @@ def test_normal_percentile_counts_faces():
 
 # --- area and volume -------------------------------------------------------
 
+
 @pytest.mark.parametrize("s", [0.5, 1.0, 1.3])
 def test_scaling_changes_area_by_s2_and_volume_by_s3(s):
     V, F = icosphere(3)
@@ -182,15 +187,18 @@ def test_volume_of_an_open_mesh_raises_and_the_report_says_nan():
 
 # --- point to surface distance and Hausdorff ---------------------------------
 
+
 def test_point_triangle_distance_in_each_region():
     A, B, C = np.array([0.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0.0, 1, 0])
-    P = np.array([
-        [0.2, 0.2, 0.7],    # above the interior: the height
-        [0.5, -0.3, 0.4],   # beside edge AB: distance to the edge
-        [-0.3, -0.4, 0.0],  # beyond corner A
-        [1.0, 1.0, 0.0],    # beyond edge BC, in the plane
-        [2.0, -1.0, 2.0],   # beyond corner B
-    ])
+    P = np.array(
+        [
+            [0.2, 0.2, 0.7],  # above the interior: the height
+            [0.5, -0.3, 0.4],  # beside edge AB: distance to the edge
+            [-0.3, -0.4, 0.0],  # beyond corner A
+            [1.0, 1.0, 0.0],  # beyond edge BC, in the plane
+            [2.0, -1.0, 2.0],  # beyond corner B
+        ]
+    )
     expected = [0.7, 0.5, 0.5, np.sqrt(2) / 2, np.sqrt(1 + 1 + 4)]
     k = len(P)
     d = point_triangle_distance(P, np.tile(A, (k, 1)), np.tile(B, (k, 1)), np.tile(C, (k, 1)))
@@ -205,9 +213,13 @@ def test_point_surface_distance_agrees_with_libigl():
     V, F = icosphere(3)
     W = add_noise(V, F, 0.02, seed=1)
     rng = np.random.default_rng(0)
-    P = np.vstack([rng.normal(size=(500, 3)) * 0.8,        # inside and around
-                   sample_surface(V, F, 500, seed=2),
-                   rng.normal(size=(50, 3)) * 10])          # far away
+    P = np.vstack(
+        [
+            rng.normal(size=(500, 3)) * 0.8,  # inside and around
+            sample_surface(V, F, 500, seed=2),
+            rng.normal(size=(50, 3)) * 10,
+        ]
+    )  # far away
     d = point_surface_distance(P, W, F)
     d2, _, _ = igl.point_mesh_squared_distance(P, W, F)
     np.testing.assert_allclose(d, np.sqrt(d2), rtol=1e-12, atol=1e-14)
@@ -278,6 +290,7 @@ def test_hausdorff_is_at_least_the_vertex_to_vertex_lower_bound_and_at_most_max_
 
 # --- dihedral angles and sharp edges -----------------------------------------
 
+
 def test_cube_edges_bend_by_90_degrees_and_face_diagonals_by_0():
     V, F = cube()
     E, angle = dihedral_angles(V, F)
@@ -296,8 +309,7 @@ def test_opening_a_hinge_by_delta_gives_sharp_edge_error_delta(delta):
     # two triangles on the edge 0-1 (the x axis) folded by 60 degrees (convex)
     def hinge(bend):
         b = np.radians(bend)
-        return np.array([[0.0, 0, 0], [1, 0, 0], [0.5, -1, 0],
-                         [0.5, np.cos(b), -np.sin(b)]])
+        return np.array([[0.0, 0, 0], [1, 0, 0], [0.5, -1, 0], [0.5, np.cos(b), -np.sin(b)]])
 
     F = np.array([[0, 2, 1], [0, 1, 3]])
     E, angle = dihedral_angles(hinge(60.0), F)
@@ -322,12 +334,14 @@ def test_smoothing_a_cube_rounds_its_sharp_edges():
     # moving every vertex towards its neighbours' mean flattens the folds
     V, F = cube()
     from geomlib.laplace import uniform_adjacency
+
     A = uniform_adjacency(len(V), F)
     W = 0.5 * V + 0.5 * (A @ V) / A.sum(axis=1)
     assert sharp_edge_error(W, V, F) > 10.0
 
 
 # --- bad input ---------------------------------------------------------------
+
 
 def test_different_vertex_counts_raise():
     V, F = icosphere(1)
@@ -394,8 +408,16 @@ def test_sweep_records_what_a_direct_run_gives():
     from geomlib.sweep import smoothing_sweep
 
     V, F = icosphere(2)
-    R = smoothing_sweep(V, F, [0.002, 0.01], seed=3, explicit_fractions=(0.25, 0.5),
-                        implicit_steps=(0.1, 1.0), iterations=(1, 3, 5), progress=False)
+    R = smoothing_sweep(
+        V,
+        F,
+        [0.002, 0.01],
+        seed=3,
+        explicit_fractions=(0.25, 0.5),
+        implicit_steps=(0.1, 1.0),
+        iterations=(1, 3, 5),
+        progress=False,
+    )
     assert R.values["rms"].shape == (2, 4, 2, 3)
     assert not np.isnan(R.values["rms"]).any()
     C = MeshComparison(V, F)

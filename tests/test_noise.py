@@ -68,13 +68,16 @@ def test_zero_sigma_returns_an_equal_copy(sphere_10k):
     assert np.array_equal(W, V) and not np.shares_memory(W, V)
 
 
-@pytest.mark.parametrize("kwargs, words", [
-    (dict(sigma=-0.1, seed=0), "sigma"),
-    (dict(sigma=float("nan"), seed=0), "sigma"),
-    (dict(sigma="a lot", seed=0), "sigma"),
-    (dict(sigma=0.1, seed=None), "seed"),
-    (dict(sigma=0.1, seed=0, direction="tangent"), "direction"),
-])
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(sigma=-0.1, seed=0), "sigma"),
+        (dict(sigma=float("nan"), seed=0), "sigma"),
+        (dict(sigma="a lot", seed=0), "sigma"),
+        (dict(sigma=0.1, seed=None), "seed"),
+        (dict(sigma=0.1, seed=0, direction="tangent"), "direction"),
+    ],
+)
 def test_bad_arguments_raise_mesh_error(kwargs, words):
     V = np.eye(3)
     F = np.array([[0, 1, 2]])

@@ -32,11 +32,19 @@ def test_show_source_of_a_check_shows_its_body_not_the_wrapper():
 
 
 def test_explain_fills_placeholders_into_markdown(shown):
-    explain("""
+    explain(
+        """
         **What happened?** The error is {err:.1%} on {n} vertices.
-        """, err=0.0123, n=42)
-    assert shown == [{"text/markdown": "**What happened?** The error is 1.2% on 42 vertices.",
-                      "text/plain": "**What happened?** The error is 1.2% on 42 vertices."}]
+        """,
+        err=0.0123,
+        n=42,
+    )
+    assert shown == [
+        {
+            "text/markdown": "**What happened?** The error is 1.2% on 42 vertices.",
+            "text/plain": "**What happened?** The error is 1.2% on 42 vertices.",
+        }
+    ]
 
 
 def test_claim_that_holds_shows_nothing(shown, monkeypatch):
@@ -54,8 +62,10 @@ def test_failed_claim_is_a_visible_note_for_a_reader(shown, monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
     assert claim(False, "K is within 10 %", "on this mesh it is {e:.0f} % because the grid is coarse", e=31) is False
     (bundle,) = shown
-    assert bundle["text/plain"] == (f"{NOTE_PREFIX} The text says K is within 10 %. With these inputs it does not "
-                                    "hold: on this mesh it is 31 % because the grid is coarse")
+    assert bundle["text/plain"] == (
+        f"{NOTE_PREFIX} The text says K is within 10 %. With these inputs it does not "
+        "hold: on this mesh it is 31 % because the grid is coarse"
+    )
     assert bundle["text/markdown"].startswith("> **Note.** The text says")
 
 
@@ -65,6 +75,7 @@ def test_note_quotes_every_line(shown):
 
 
 # -- the check vocabulary ---------------------------------------------------------------------
+
 
 @exercise("double", reread="section 1")
 def _check_double(fn):
@@ -130,4 +141,7 @@ def test_use_falls_back_to_the_reference(capsys, monkeypatch):
 def test_braces_in_the_values_are_not_placeholders(shown, monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
     claim(False, "the set is {s}", "$\\frac{{1}}{{2}}$ differs", s={1, 2})
-    assert shown[0]["text/plain"] == f"{NOTE_PREFIX} The text says the set is {{1, 2}}. With these inputs it does not hold: $\\frac{{1}}{{2}}$ differs"
+    assert (
+        shown[0]["text/plain"]
+        == f"{NOTE_PREFIX} The text says the set is {{1, 2}}. With these inputs it does not hold: $\\frac{{1}}{{2}}$ differs"
+    )

@@ -23,8 +23,9 @@ def test_notebook_is_clean(path):
     nb = json.loads(path.read_text(encoding="utf-8"))
     assert nb["nbformat"] == 4
     with_outputs = [i for i, c in enumerate(nb["cells"]) if c["cell_type"] == "code" and c.get("outputs")]
-    counted = [i for i, c in enumerate(nb["cells"])
-               if c["cell_type"] == "code" and c.get("execution_count") is not None]
+    counted = [
+        i for i, c in enumerate(nb["cells"]) if c["cell_type"] == "code" and c.get("execution_count") is not None
+    ]
     assert not with_outputs, f"cells {with_outputs} have outputs; {HOW}"
     assert not counted, f"cells {counted} have execution counts; {HOW}"
     assert "widgets" not in nb["metadata"], f"widget state saved in the metadata; {HOW}"
@@ -34,7 +35,8 @@ def test_notebook_is_clean(path):
 
 def _dirty_notebook():
     return {
-        "nbformat": 4, "nbformat_minor": 5,
+        "nbformat": 4,
+        "nbformat_minor": 5,
         "metadata": {
             "kernelspec": {"name": "myenv", "display_name": "My env", "language": "python"},
             "language_info": {"name": "python", "version": "3.11.2"},
@@ -42,10 +44,14 @@ def _dirty_notebook():
         },
         "cells": [
             {"cell_type": "markdown", "id": "m1", "metadata": {}, "source": "# Title"},
-            {"cell_type": "code", "id": "c1", "execution_count": 7,
-             "metadata": {"execution": {"iopub.status.busy": "2026-01-01"}, "tags": ["keep"], "scrolled": True},
-             "outputs": [{"output_type": "stream", "name": "stdout", "text": "hi\n"}],
-             "source": "print('hi')"},
+            {
+                "cell_type": "code",
+                "id": "c1",
+                "execution_count": 7,
+                "metadata": {"execution": {"iopub.status.busy": "2026-01-01"}, "tags": ["keep"], "scrolled": True},
+                "outputs": [{"output_type": "stream", "name": "stdout", "text": "hi\n"}],
+                "source": "print('hi')",
+            },
         ],
     }
 
@@ -55,13 +61,13 @@ def test_strip_tool_cleans_and_is_idempotent(tmp_path):
     path.write_text(json.dumps(_dirty_notebook()))
     check = subprocess.run([sys.executable, STRIP, "--check", path], capture_output=True, text=True)
     assert check.returncode == 1 and "not clean" in check.stdout
-    assert json.loads(path.read_text())["cells"][1]["outputs"]        # --check changes nothing
+    assert json.loads(path.read_text())["cells"][1]["outputs"]  # --check changes nothing
 
     subprocess.run([sys.executable, STRIP, path], check=True, capture_output=True)
     nb = json.loads(path.read_text())
     code = nb["cells"][1]
     assert code["outputs"] == [] and code["execution_count"] is None
-    assert code["metadata"] == {"tags": ["keep"]}                      # tags survive
+    assert code["metadata"] == {"tags": ["keep"]}  # tags survive
     assert code["source"] == "print('hi')" and code["id"] == "c1"
     assert "widgets" not in nb["metadata"]
     assert nb["metadata"]["kernelspec"]["name"] == "python3"

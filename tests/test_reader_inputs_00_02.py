@@ -67,21 +67,47 @@ def test_00_y_up_millimetres(awkward):
 
 
 def test_01_low_ends_on_the_cad_part(awkward):
-    run = ran(NB01, MESH=awkward["cad_part"], PLANE=Raw('geomlib.data_path("plane_irregular.obj")'), RESOLUTION=8, SLIDER_RESOLUTION=8, JITTER_MAX=0.0,
-              SPHERE_SUBDIVISIONS=1, UV_RINGS=8, SEED=0)
+    run = ran(
+        NB01,
+        MESH=awkward["cad_part"],
+        PLANE=Raw('geomlib.data_path("plane_irregular.obj")'),
+        RESOLUTION=8,
+        SLIDER_RESOLUTION=8,
+        JITTER_MAX=0.0,
+        SPHERE_SUBDIVISIONS=1,
+        UV_RINGS=8,
+        SEED=0,
+    )
     assert any("within 10 %" in n and "coarser grid" in n for n in run.notes), run.notes
     assert any("within 1 % of 1" in n and "coarse sphere" in n for n in run.notes), run.notes
 
 
 def test_01_high_ends_on_two_components(awkward):
-    run = ran(NB01, MESH=awkward["two_components"], RESOLUTION=128, SLIDER_RESOLUTION=64, JITTER_MAX=0.45,
-              SPHERE_SUBDIVISIONS=6, UV_RINGS=128, SEED=123)
+    run = ran(
+        NB01,
+        MESH=awkward["two_components"],
+        RESOLUTION=128,
+        SLIDER_RESOLUTION=64,
+        JITTER_MAX=0.45,
+        SPHERE_SUBDIVISIONS=6,
+        UV_RINGS=128,
+        SEED=123,
+    )
     assert not run.notes, run.notes
 
 
 def test_02_spheroid_at_the_ends_of_the_ranges(awkward):
-    run = ran(NB02, A_NUM=0.2, B_NUM=3.0, C_NUM=3.0, GENERIC_U=1.5, GENERIC_V=0.1, SUBDIVISIONS=1,
-              MESH=awkward["y_up_millimetres"], SEED=0)
+    run = ran(
+        NB02,
+        A_NUM=0.2,
+        B_NUM=3.0,
+        C_NUM=3.0,
+        GENERIC_U=1.5,
+        GENERIC_V=0.1,
+        SUBDIVISIONS=1,
+        MESH=awkward["y_up_millimetres"],
+        SEED=0,
+    )
     assert any("not all different" in n and "spheroid" in n for n in run.notes), run.notes
 
 

@@ -30,22 +30,47 @@ def said(run, *phrases):
 
 def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
     # issue 11: LEVELS = [2, 3, 4] with JITTER = 0.1 stopped at an AssertionError ('K', 'barycentric')
-    run = ran(NB03, MESH=str(scan_with_holes(tmp_path)), LEVELS=[2, 3, 4], JITTER=0.1, VIEW_LEVEL=1,
-              SADDLE_N=8, SADDLE_JITTER=0.0, AXES=(1.0, 0.7, 0.5))
-    said(run, "12 vertices are not used by any face", "geomlib.repair.remove_unreferenced_vertices",
-         "does not converge on jittered meshes", "JITTER = 0.1", "VIEW_LEVEL = 1", "SADDLE_JITTER = 0.0")
+    run = ran(
+        NB03,
+        MESH=str(scan_with_holes(tmp_path)),
+        LEVELS=[2, 3, 4],
+        JITTER=0.1,
+        VIEW_LEVEL=1,
+        SADDLE_N=8,
+        SADDLE_JITTER=0.0,
+        AXES=(1.0, 0.7, 0.5),
+    )
+    said(
+        run,
+        "12 vertices are not used by any face",
+        "geomlib.repair.remove_unreferenced_vertices",
+        "does not converge on jittered meshes",
+        "JITTER = 0.1",
+        "VIEW_LEVEL = 1",
+        "SADDLE_JITTER = 0.0",
+    )
 
 
 def test_03_two_components_sphere_axes_and_high_ends(tmp_path):
-    run = ran(NB03, MESH=str(two_components(tmp_path)), LEVELS=[1], JITTER=0.4, AXES=(1.0, 1.0, 1.0),
-              VIEW_LEVEL=5, SADDLE_N=200, SADDLE_JITTER=0.35, SEED=7)
+    run = ran(
+        NB03,
+        MESH=str(two_components(tmp_path)),
+        LEVELS=[1],
+        JITTER=0.4,
+        AXES=(1.0, 1.0, 1.0),
+        VIEW_LEVEL=5,
+        SADDLE_N=200,
+        SADDLE_JITTER=0.35,
+        SEED=7,
+    )
     said(run, "A slope needs at least two levels")
     assert not re.search(r"\bnan\b", run.outputs_text()), "a number printed as nan"
 
 
 def test_03_cad_part_long_ellipsoid(tmp_path):
-    run = ran(NB03, MESH=str(cad_part(tmp_path)), LEVELS=[1, 2], AXES=(3.0, 1.0, 0.2), JITTER=0.3, VIEW_LEVEL=2,
-              SADDLE_N=16)
+    run = ran(
+        NB03, MESH=str(cad_part(tmp_path)), LEVELS=[1, 2], AXES=(3.0, 1.0, 0.2), JITTER=0.3, VIEW_LEVEL=2, SADDLE_N=16
+    )
     said(run, "over levels [1, 2]")
 
 

@@ -7,7 +7,6 @@ components, a large CUBE, steps past every limit, absolute and scale-free units)
 """
 
 import pytest
-
 from awkward_meshes import make_all
 from meshdata import COURSE, needs_course
 from notebook_runner import run_notebook
@@ -26,9 +25,17 @@ def notes_of(run):
 
 @needs_course
 def test_05_course_meshes_with_the_assignments_absolute_step():
-    run = run_notebook("05_explicit_smoothing.ipynb", PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
-                       PART=str(COURSE / "smoothing" / "fandisk_ns.obj"), STEP=1e-5, STEP_UNIT="length^2",
-                       BREAK_MARGIN=0.3, BREAK_ITERATIONS=20, ITERATIONS=0, CUBE_STEPS=1)
+    run = run_notebook(
+        "05_explicit_smoothing.ipynb",
+        PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+        PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
+        STEP=1e-5,
+        STEP_UNIT="length^2",
+        BREAK_MARGIN=0.3,
+        BREAK_ITERATIONS=20,
+        ITERATIONS=0,
+        CUBE_STEPS=1,
+    )
     run.assert_ran()
     text, notes = run.outputs_text(), notes_of(run)
     # the conversion table: 1e-5 is 0.0278 of fandisk_ns's limit and 2.1 times plane_ns's
@@ -40,13 +47,21 @@ def test_05_course_meshes_with_the_assignments_absolute_step():
     # plane_ns is a regular grid: uniform weights have nothing to slide, and the note says so
     assert "a regular grid, with equal valences and equal triangles, has nothing to even out" in notes
     assert "PART's diagonal is 28.2 times PLANE's" in text
-    assert len(run.notes) == 2, run.notes        # the step past plane_ns's limit, and the regular grid
+    assert len(run.notes) == 2, run.notes  # the step past plane_ns's limit, and the regular grid
 
 
 def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
-    run = run_notebook("05_explicit_smoothing.ipynb", PLANE=awkward["y_up_millimetres"],
-                       PART=awkward["two_components"], CUBE=awkward["cad_part"], STEP=0.5,
-                       BREAK_MARGIN=0.005, BREAK_ITERATIONS=1000, ITERATIONS=1000, CUBE_STEPS=50)
+    run = run_notebook(
+        "05_explicit_smoothing.ipynb",
+        PLANE=awkward["y_up_millimetres"],
+        PART=awkward["two_components"],
+        CUBE=awkward["cad_part"],
+        STEP=0.5,
+        BREAK_MARGIN=0.005,
+        BREAK_ITERATIONS=1000,
+        ITERATIONS=1000,
+        CUBE_STEPS=50,
+    )
     run.assert_ran()
     notes = notes_of(run)
     assert "2 connected components" in notes and "largest_component" in notes
@@ -59,9 +74,15 @@ def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
 
 @needs_course
 def test_06_course_meshes_with_the_assignments_absolute_step():
-    run = run_notebook("06_implicit_smoothing.ipynb", PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
-                       PART=str(COURSE / "smoothing" / "fandisk_ns.obj"), STEP=1e-5, STEP_UNIT="length^2",
-                       ITERATIONS=1, SMOOTHING_TIME=0.1)
+    run = run_notebook(
+        "06_implicit_smoothing.ipynb",
+        PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+        PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
+        STEP=1e-5,
+        STEP_UNIT="length^2",
+        ITERATIONS=1,
+        SMOOTHING_TIME=0.1,
+    )
     run.assert_ran()
     text = run.outputs_text()
     assert "| part | assignment's 1e-05 | | | | 1e-05 | 0.000833 | 0.02782 |" in text
@@ -70,9 +91,16 @@ def test_06_course_meshes_with_the_assignments_absolute_step():
 
 
 def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
-    run = run_notebook("06_implicit_smoothing.ipynb", PLANE=awkward["scan_with_holes"],
-                       PART=awkward["scan_with_holes"], CUBE=awkward["two_components"],
-                       SPHERE=awkward["y_up_millimetres"], STEP=100.0, ITERATIONS=50, SMOOTHING_TIME=100.0)
+    run = run_notebook(
+        "06_implicit_smoothing.ipynb",
+        PLANE=awkward["scan_with_holes"],
+        PART=awkward["scan_with_holes"],
+        CUBE=awkward["two_components"],
+        SPHERE=awkward["y_up_millimetres"],
+        STEP=100.0,
+        ITERATIONS=50,
+        SMOOTHING_TIME=100.0,
+    )
     run.assert_ran()
     notes = notes_of(run)
     assert "not used by any face" in notes and "remove_unreferenced_vertices" in notes

@@ -8,8 +8,8 @@ from geomlib.repair import largest_component, prepare, remove_unreferenced_verti
 
 
 def _two_spheres():
-    a = surfaces.sphere(1.0, subdivisions=1)      # 42 vertices, 80 faces
-    b = surfaces.sphere(1.0, subdivisions=2)      # 162 vertices, 320 faces
+    a = surfaces.sphere(1.0, subdivisions=1)  # 42 vertices, 80 faces
+    b = surfaces.sphere(1.0, subdivisions=2)  # 162 vertices, 320 faces
     return np.vstack([a.V, b.V + 5]), np.vstack([a.F, b.F + len(a.V)]), len(a.V)
 
 
@@ -30,7 +30,7 @@ def test_largest_component_keeps_the_one_with_most_faces():
 
 def test_zero_area_faces_are_dropped():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0]])
-    F = np.array([[0, 1, 2], [0, 1, 3]])            # the second is flat on a line
+    F = np.array([[0, 1, 2], [0, 1, 3]])  # the second is flat on a line
     _, F2, kept = remove_zero_area_faces(V, F)
     assert np.array_equal(F2, F[:1]) and np.array_equal(kept, [0])
 

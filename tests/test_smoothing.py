@@ -53,6 +53,7 @@ def plane_distance(V):
 # ---------------------------------------------------------------------------
 # a plane stays planar
 
+
 @pytest.mark.parametrize("weights", ["cotan", "uniform"])
 @pytest.mark.parametrize("boundary", ["fixed", "free"])
 def test_plane_stays_planar(weights, boundary):
@@ -77,6 +78,7 @@ def test_fixed_boundary_stays_and_free_boundary_moves():
 
 # ---------------------------------------------------------------------------
 # a sphere stays a sphere, centred where it was
+
 
 @pytest.mark.parametrize("keep_volume", [False, True])
 def test_sphere_stays_sphere_centred(keep_volume):
@@ -113,6 +115,7 @@ def test_keep_volume_on_open_mesh_is_an_error():
 # ---------------------------------------------------------------------------
 # explicit uniform step 1 = neighbour averaging
 
+
 @pytest.mark.parametrize("mesh", ["sphere", "grid"])
 def test_uniform_step_one_is_neighbour_average(mesh):
     V, F = icosphere(2) if mesh == "sphere" else grid(8, jitter=0.5)
@@ -134,6 +137,7 @@ def test_uniform_limit_is_at_least_one():
 
 # ---------------------------------------------------------------------------
 # implicit with step -> 0 changes nothing; explicit limit laws
+
 
 @pytest.mark.parametrize("weights", ["cotan", "uniform"])
 def test_implicit_tiny_step_changes_nothing(weights):
@@ -168,8 +172,9 @@ def test_explicit_just_above_limit_grows_just_below_decays(weights, subdivisions
         amps = []
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MeshWarning)
-            explicit_smoothing(V, F, fraction * limit, 60, weights,
-                               callback=lambda k, P: amps.append(e @ (m * P[:, j])))
+            explicit_smoothing(
+                V, F, fraction * limit, 60, weights, callback=lambda k, P: amps.append(e @ (m * P[:, j]))
+            )
         return np.abs(np.array(amps))
 
     above, below = amplitude_history(1.02), amplitude_history(0.98)
@@ -197,7 +202,9 @@ def test_step_limit_scaling_law():
     V, F = icosphere(3)
     for s in (1e-3, 1.0, 250.0):
         assert explicit_step_limit(s * V, F, "cotan") == pytest.approx(s**2 * explicit_step_limit(V, F), rel=1e-8)
-        assert explicit_step_limit(s * V, F, "uniform") == pytest.approx(explicit_step_limit(V, F, "uniform"), rel=1e-12)
+        assert explicit_step_limit(s * V, F, "uniform") == pytest.approx(
+            explicit_step_limit(V, F, "uniform"), rel=1e-12
+        )
 
 
 def test_step_limit_fixed_boundary_at_least_free():
@@ -210,8 +217,9 @@ def test_step_fraction_equals_step():
     V, F = icosphere(2)
     V = V + 0.02 * np.random.default_rng(3).standard_normal(V.shape)
     limit = explicit_step_limit(V, F)
-    np.testing.assert_array_equal(explicit_smoothing(V, F, step_fraction=0.5, iterations=4),
-                                  explicit_smoothing(V, F, 0.5 * limit, 4))
+    np.testing.assert_array_equal(
+        explicit_smoothing(V, F, step_fraction=0.5, iterations=4), explicit_smoothing(V, F, 0.5 * limit, 4)
+    )
 
 
 def test_lanczos_limit_agrees_with_eigsh():
@@ -219,14 +227,21 @@ def test_lanczos_limit_agrees_with_eigsh():
     V = V * np.array([1.0, 2.0, 3.0])  # an ellipsoid: no symmetric clusters
     for w in ("cotan", "uniform"):
         M, C = laplacian(V, F, w)
-        lam = sla.eigsh(-C, k=1, M=M.tocsc(), which="LA", tol=1e-12,
-                        v0=np.random.default_rng(0).standard_normal(len(V)),
-                        return_eigenvectors=False)[0]
+        lam = sla.eigsh(
+            -C,
+            k=1,
+            M=M.tocsc(),
+            which="LA",
+            tol=1e-12,
+            v0=np.random.default_rng(0).standard_normal(len(V)),
+            return_eigenvectors=False,
+        )[0]
         assert explicit_step_limit(V, F, w) == pytest.approx(2 / lam, rel=1e-6)
 
 
 # ---------------------------------------------------------------------------
 # implicit equals a direct sparse solve
+
 
 @pytest.mark.parametrize("weights", ["cotan", "uniform"])
 def test_implicit_equals_direct_solve_closed(weights):
@@ -239,8 +254,7 @@ def test_implicit_equals_direct_solve_closed(weights):
     for _ in range(3):
         P = sla.spsolve(A, M @ P)
     np.testing.assert_allclose(implicit_smoothing(V, F, step, 3, weights), P, rtol=0, atol=1e-10)
-    np.testing.assert_allclose(implicit_smoothing(V, F, step, 3, weights, solver="cg"), P,
-                               rtol=0, atol=1e-8)
+    np.testing.assert_allclose(implicit_smoothing(V, F, step, 3, weights, solver="cg"), P, rtol=0, atol=1e-8)
 
 
 def test_implicit_equals_direct_solve_fixed_boundary():
@@ -278,6 +292,7 @@ def test_smoother_cache_reuses_factorisation():
 # ---------------------------------------------------------------------------
 # rebuilt operator (curvature flow) and divergence: stated stops, never NaN
 
+
 def test_rebuilt_operator_collapse_is_a_clear_error():
     V, F = icosphere(2)
     with pytest.raises(MeshError, match="implicit smoothing stopped") as info:
@@ -313,6 +328,7 @@ def test_explicit_divergence_stops_cleanly():
 
 # ---------------------------------------------------------------------------
 # bad input
+
 
 @pytest.mark.parametrize("step", [-0.1, float("nan"), float("inf"), "0.1", None, True])
 def test_bad_step(step):
@@ -371,6 +387,7 @@ def test_progress_bar_options_do_not_change_results(capsys):
 # ---------------------------------------------------------------------------
 # the course meshes (skipped when the course folder is absent)
 
+
 @pytest.mark.skipif(not (COURSE / "smoothing" / "plane_ns.obj").exists(), reason="course meshes absent")
 def test_course_noisy_plane():
     from geomlib import load_mesh
@@ -403,8 +420,7 @@ def test_the_formulas_are_one_step_of_the_smoothers():
     V = V + 0.02 * np.random.default_rng(3).standard_normal(V.shape)
     M, C = laplacian(V, F)
     tau = 0.5 * explicit_step_limit(V, F)
-    np.testing.assert_allclose(explicit_step(V, M, C, tau),
-                               V + tau * sp.diags(1 / M.diagonal()) @ (C @ V), atol=1e-14)
+    np.testing.assert_allclose(explicit_step(V, M, C, tau), V + tau * sp.diags(1 / M.diagonal()) @ (C @ V), atol=1e-14)
     np.testing.assert_allclose(explicit_step(V, M, C, tau), explicit_smoothing(V, F, tau, 1), atol=1e-13)
     P = implicit_step(V, M, C, 10 * tau)
     np.testing.assert_allclose((M - 10 * tau * C) @ P, M @ V, atol=1e-12)
@@ -418,18 +434,24 @@ def test_not_positive_definite_is_a_clear_error():
         factorise(sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]])))
 
 
-@pytest.mark.parametrize("call", [
-    lambda V, F: explicit_smoothing(V, F, 1e-4, 2),
-    lambda V, F: explicit_step_limit(V, F),
-    lambda V, F: implicit_smoothing(V, F, 1e-3, 2),
-    lambda V, F: implicit_smoothing(V, F, 1e-3, 2, rebuild=True),
-    lambda V, F: ImplicitSmoother(V, F),
-])
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda V, F: explicit_smoothing(V, F, 1e-4, 2),
+        lambda V, F: explicit_step_limit(V, F),
+        lambda V, F: implicit_smoothing(V, F, 1e-3, 2),
+        lambda V, F: implicit_smoothing(V, F, 1e-3, 2, rebuild=True),
+        lambda V, F: ImplicitSmoother(V, F),
+    ],
+)
 def test_unused_vertices_are_named_never_nan(call):
     V, F = icosphere(1)
     V2 = np.vstack([V, [[3.0, 0.0, 0.0]], V[:2] + 5.0])  # vertices 42, 43, 44 used by no face
-    with pytest.raises(MeshError, match=r"3 vertices are used by no face \(42, 43, 44\).*"
-                                        r"remove_unreferenced_vertices\(V, F\)"):
+    with pytest.raises(
+        MeshError,
+        match=r"3 vertices are used by no face \(42, 43, 44\).*"
+        r"remove_unreferenced_vertices\(V, F\)",
+    ):
         call(V2, F)
 
 
@@ -447,8 +469,8 @@ def test_several_components_smooth_independently():
     V2 = np.vstack([V, V + [5.0, 0.0, 0.0]])
     F2 = np.vstack([F, F + len(V)])
     P = implicit_smoothing(V2, F2, 0.01, 3)
-    np.testing.assert_allclose(P[:len(V)], implicit_smoothing(V, F, 0.01, 3), atol=1e-12)
-    np.testing.assert_allclose(P[len(V):], implicit_smoothing(V, F, 0.01, 3) + [5.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(P[: len(V)], implicit_smoothing(V, F, 0.01, 3), atol=1e-12)
+    np.testing.assert_allclose(P[len(V) :], implicit_smoothing(V, F, 0.01, 3) + [5.0, 0.0, 0.0], atol=1e-12)
 
 
 def test_smoother_history_matches_fresh_runs():

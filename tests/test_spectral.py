@@ -239,7 +239,7 @@ def test_several_components_give_several_zero_eigenvalues():
     # indicator functions, the largest component first
     n = len(P)
     assert np.allclose(E[:n, 0], 1 / np.sqrt(m[:n].sum())) and np.allclose(E[n:, 0], 0)
-    assert np.allclose(E[n:2 * n, 1], 1 / np.sqrt(m[n:2 * n].sum())) and np.allclose(E[:n, 1], 0)
+    assert np.allclose(E[n : 2 * n, 1], 1 / np.sqrt(m[n : 2 * n].sum())) and np.allclose(E[:n, 1], 0)
     assert np.abs(E.T @ (m[:, None] * E) - np.eye(16)).max() < 1e-8
     assert np.abs(C @ E + (m[:, None] * E) * lam).max() < 1e-9 * np.abs(C).max()
     # each component's own spectrum: the unit sphere has 2 three times, the
@@ -301,8 +301,11 @@ def test_k_not_an_integer(egg, k):
 def test_isolated_vertex_is_named(egg):
     V, F = egg
     V2 = np.vstack([V, [[5.0, 5.0, 5.0]]])
-    with pytest.raises(MeshError, match=rf"1 vertices are used by no face \({len(V)}\).*"
-                                         r"geomlib.repair.remove_unreferenced_vertices\(V, F\)"):
+    with pytest.raises(
+        MeshError,
+        match=rf"1 vertices are used by no face \({len(V)}\).*"
+        r"geomlib.repair.remove_unreferenced_vertices\(V, F\)",
+    ):
         eigenbasis(V2, F, 5, cache=False)
     with pytest.raises(MeshError, match="remove_unreferenced_vertices"):
         spectral_reconstruction(V2, F, 5)
@@ -444,8 +447,14 @@ def test_unwritable_cache_folder(egg, tmp_path, monkeypatch):
 
 
 def test_public_names():
-    for name in ("eigenbasis", "spectral_reconstruction", "spectral_basis", "SpectralBasis",
-                 "spectral_cache_dir", "clear_spectral_cache"):
+    for name in (
+        "eigenbasis",
+        "spectral_reconstruction",
+        "spectral_basis",
+        "SpectralBasis",
+        "spectral_cache_dir",
+        "clear_spectral_cache",
+    ):
         assert name in geomlib.__all__ and callable(getattr(geomlib, name))
 
 

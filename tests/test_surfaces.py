@@ -61,9 +61,7 @@ def ellipsoid_p(a, b, c):
 
 
 def torus_p(R, r):
-    return lambda u, v: np.stack(
-        [(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1
-    )
+    return lambda u, v: np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1)
 
 
 # ---------------------------------------------------------------------------
@@ -166,7 +164,9 @@ def test_open_meshes_have_one_boundary_loop_on_the_square(kind, jitter):
     assert m.V.shape[0] - nE + m.F.shape[0] == 1  # a disc
     half = m.params["size"] / 2
     # the square's outline is kept exactly: boundary vertices stay on the sides
-    E = np.unique(np.sort(np.concatenate([m.F[:, [0, 1]], m.F[:, [1, 2]], m.F[:, [2, 0]]]), axis=1), axis=0, return_counts=True)
+    E = np.unique(
+        np.sort(np.concatenate([m.F[:, [0, 1]], m.F[:, [1, 2]], m.F[:, [2, 0]]]), axis=1), axis=0, return_counts=True
+    )
     bnd = np.unique(E[0][E[1] == 1])
     on_side = np.isclose(np.abs(m.V[bnd, 0]), half, atol=1e-15) | np.isclose(np.abs(m.V[bnd, 1]), half, atol=1e-15)
     assert on_side.all()
@@ -280,7 +280,7 @@ def test_saddle_closed_form_at_the_origin_and_sign_on_a_bump():
     m = S.saddle(n=20, amplitude=A, monkey=0.1)
     o = np.flatnonzero((m.V[:, 0] == 0) & (m.V[:, 1] == 0))[0]
     assert abs(m.H[o]) < 1e-15
-    np.testing.assert_allclose(m.K[o], -(6.75 * A) ** 2, rtol=1e-14)
+    np.testing.assert_allclose(m.K[o], -((6.75 * A) ** 2), rtol=1e-14)
     np.testing.assert_allclose([m.k1[o], m.k2[o]], [6.75 * A, -6.75 * A], rtol=1e-14)
     np.testing.assert_allclose(m.N[o], [0, 0, 1], atol=1e-15)
     # the highest vertex sits on a bump that bends down, away from the upward normal
@@ -426,7 +426,9 @@ def test_jitter_makes_triangles_irregular():
         for i in range(3):
             e1 = P[:, (i + 1) % 3] - P[:, i]
             e2 = P[:, (i + 2) % 3] - P[:, i]
-            out.append(np.arccos(np.einsum("ij,ij->i", e1, e2) / np.linalg.norm(e1, axis=1) / np.linalg.norm(e2, axis=1)))
+            out.append(
+                np.arccos(np.einsum("ij,ij->i", e1, e2) / np.linalg.norm(e1, axis=1) / np.linalg.norm(e2, axis=1))
+            )
         return np.degrees(np.concatenate(out))
 
     regular = angles(S.plane(n=16))
@@ -529,7 +531,9 @@ def test_truth_is_computed_on_first_access_and_kept():
     assert "_values" in m.__dict__ and m.H is H
 
 
-@pytest.mark.parametrize("make", [lambda: S.ellipsoid(1.0, 0.7, 0.5, subdivisions=2), lambda: S.uv_ellipsoid(1.0, 0.7, 0.5, n=6)])
+@pytest.mark.parametrize(
+    "make", [lambda: S.ellipsoid(1.0, 0.7, 0.5, subdivisions=2), lambda: S.uv_ellipsoid(1.0, 0.7, 0.5, n=6)]
+)
 def test_ellipsoid_truth_at_the_poles(make):
     # the parametrisation is singular at v = 0, pi; the truth there is still exact:
     # normal +-z, principal curvatures c / a^2 and c / b^2

@@ -20,13 +20,13 @@ RNG_SEED = 20240611
 # ----------------------------------------------------------------- numpy models
 # Written independently of geomlib.symbolic: plain numpy formulas of p(u, v).
 def p_ellipsoid(a, b, c):
-    return lambda u, v: np.stack([a * np.cos(u) * np.sin(v), b * np.sin(u) * np.sin(v),
-                                  c * np.cos(v) + 0 * u], axis=-1)
+    return lambda u, v: np.stack([a * np.cos(u) * np.sin(v), b * np.sin(u) * np.sin(v), c * np.cos(v) + 0 * u], axis=-1)
 
 
 def p_torus(R, r):
-    return lambda u, v: np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u),
-                                  r * np.sin(v) + 0 * u], axis=-1)
+    return lambda u, v: np.stack(
+        [(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v) + 0 * u], axis=-1
+    )
 
 
 def p_helicoid(c):
@@ -171,8 +171,11 @@ def test_ellipsoid_symbolic_forms_with_symbols():
     assert sp.simplify(I[0, 1] - (b**2 - a**2) * sp.sin(u) * sp.cos(u) * sp.sin(v) * sp.cos(v)) == 0
     II = E.second_fundamental_form()
     assert II[0, 1] == 0
-    W = sp.sqrt(b**2 * c**2 * sp.cos(u) ** 2 * sp.sin(v) ** 2 + a**2 * c**2 * sp.sin(u) ** 2 * sp.sin(v) ** 2
-                + a**2 * b**2 * sp.cos(v) ** 2)
+    W = sp.sqrt(
+        b**2 * c**2 * sp.cos(u) ** 2 * sp.sin(v) ** 2
+        + a**2 * c**2 * sp.sin(u) ** 2 * sp.sin(v) ** 2
+        + a**2 * b**2 * sp.cos(v) ** 2
+    )
     assert sp.simplify(II[0, 0] - a * b * c * sp.sin(v) ** 2 / W) == 0
     assert sp.simplify(II[1, 1] - a * b * c / W) == 0
     assert sp.simplify(E.gaussian_curvature() - (a * b * c) ** 2 / W**4) == 0
@@ -201,8 +204,9 @@ def test_curvatures_scale_as_one_over_length():
         scaled = ellipsoid(1.1 * s, 0.7 * s, 1.9 * s)
         for name, power in (("mean_curvature", 1), ("gaussian_curvature", 2)):
             np.testing.assert_allclose(scaled.lambdify(name)(u, v), base.lambdify(name)(u, v) / s**power, rtol=1e-11)
-        np.testing.assert_allclose(scaled.lambdify("normal_curvature")(u, v, ph),
-                                   base.lambdify("normal_curvature")(u, v, ph) / s, rtol=1e-11)
+        np.testing.assert_allclose(
+            scaled.lambdify("normal_curvature")(u, v, ph), base.lambdify("normal_curvature")(u, v, ph) / s, rtol=1e-11
+        )
         for k_s, k_b in zip(scaled.lambdify("principal_curvatures")(u, v), base.lambdify("principal_curvatures")(u, v)):
             np.testing.assert_allclose(k_s, k_b / s, rtol=1e-11)
     # and symbolically, with a scale symbol s
@@ -220,6 +224,7 @@ def section_curvature(F, P, t, n, h=2e-3):
     The curve is the graph sigma(tau) over the tangent line: F(P + tau t + sigma n) = 0,
     solved by root finding; sigma''(0) by a fourth-order central difference.
     """
+
     def sigma(tau):
         g = lambda s: F(P + tau * t + s * n)
         return brentq(g, -0.2, 0.2, xtol=1e-15, maxiter=200)
@@ -271,11 +276,14 @@ def test_normal_curvature_at_random_points_equals_normal_section(seed):
 
 
 # ------------------------------------- Euler's theorem, principal directions
-@pytest.mark.parametrize("make,urange,vrange", [
-    (lambda: ellipsoid(1.0, 2.0, 3.0), (0, 2 * np.pi), (0.1, np.pi - 0.1)),
-    (lambda: torus(2, 0.6), (0, 2 * np.pi), (0, 2 * np.pi)),
-    (saddle, (-1, 1), (-1, 1)),
-])
+@pytest.mark.parametrize(
+    "make,urange,vrange",
+    [
+        (lambda: ellipsoid(1.0, 2.0, 3.0), (0, 2 * np.pi), (0.1, np.pi - 0.1)),
+        (lambda: torus(2, 0.6), (0, 2 * np.pi), (0, 2 * np.pi)),
+        (saddle, (-1, 1), (-1, 1)),
+    ],
+)
 def test_euler_theorem_and_principal_directions(make, urange, vrange):
     S = make()
     rng = np.random.default_rng(RNG_SEED)
@@ -387,7 +395,9 @@ def test_rigid_motion_leaves_curvature_unchanged():
     a, b, c = 1, 2, sp.Rational(3, 2)
     p = sp.Matrix([a * sp.cos(u) * sp.sin(v), b * sp.sin(u) * sp.sin(v), c * sp.cos(v)])
     Q = sp.Matrix([[sp.Rational(3, 5), -sp.Rational(4, 5), 0], [sp.Rational(4, 5), sp.Rational(3, 5), 0], [0, 0, 1]])
-    Q = Q * sp.Matrix([[1, 0, 0], [0, sp.Rational(5, 13), -sp.Rational(12, 13)], [0, sp.Rational(12, 13), sp.Rational(5, 13)]])
+    Q = Q * sp.Matrix(
+        [[1, 0, 0], [0, sp.Rational(5, 13), -sp.Rational(12, 13)], [0, sp.Rational(12, 13), sp.Rational(5, 13)]]
+    )
     moved = symbolic.ParametricSurface(Q * p + sp.Matrix([1, -2, 3]), u, v, orientation=-1, closed=True)
     ref = ellipsoid(a, b, c)
     rng = np.random.default_rng(RNG_SEED)
@@ -395,7 +405,9 @@ def test_rigid_motion_leaves_curvature_unchanged():
     for name in ("mean_curvature", "gaussian_curvature"):
         np.testing.assert_allclose(moved.lambdify(name)(uu, vv), ref.lambdify(name)(uu, vv), rtol=1e-10)
     Qn = np.array(Q, dtype=float)
-    np.testing.assert_allclose(moved.lambdify("unit_normal")(uu, vv), ref.lambdify("unit_normal")(uu, vv) @ Qn.T, atol=1e-12)
+    np.testing.assert_allclose(
+        moved.lambdify("unit_normal")(uu, vv), ref.lambdify("unit_normal")(uu, vv) @ Qn.T, atol=1e-12
+    )
 
 
 # ------------------------------------------------------- numpy interface
@@ -412,7 +424,9 @@ def test_lambdify_shapes_and_broadcasting():
     assert E.lambdify("p_u")(u, v).shape == (3, 4, 3)
     # the family with free parameters takes them as trailing arguments
     fam = ellipsoid(*sp.symbols("a b c", positive=True))
-    np.testing.assert_allclose(fam.lambdify("mean_curvature")(u, v, 1, 2, 3), E.lambdify("mean_curvature")(u, v), rtol=1e-13)
+    np.testing.assert_allclose(
+        fam.lambdify("mean_curvature")(u, v, 1, 2, 3), E.lambdify("mean_curvature")(u, v), rtol=1e-13
+    )
     with pytest.raises(TypeError):
         fam.lambdify("mean_curvature")(u, v)
 
@@ -426,8 +440,13 @@ def test_bad_input_is_refused():
         ellipsoid(1, 2, 3).lambdify("curvature")
     u, v = sp.symbols("u v", real=True)
     with pytest.raises(ValueError, match="p_u x p_v"):
-        symbolic.ParametricSurface((sp.cos(u) * sp.sin(v), sp.sin(u) * sp.sin(v), sp.cos(v)), u, v,
-                                   normal_direction=(sp.cos(u), sp.sin(u), 0), area_factor=1)
+        symbolic.ParametricSurface(
+            (sp.cos(u) * sp.sin(v), sp.sin(u) * sp.sin(v), sp.cos(v)),
+            u,
+            v,
+            normal_direction=(sp.cos(u), sp.sin(u), 0),
+            area_factor=1,
+        )
 
 
 def test_results_are_cached_and_families_shared():
@@ -444,7 +463,7 @@ def test_ellipsoid_forms_at_a_point_and_kappa_n_at_the_axis_end():
     assert sp.simplify(I - sp.diag(b**2, c**2)) == sp.zeros(2, 2)
     assert sp.simplify(II - sp.diag(a, a)) == sp.zeros(2, 2)
     phi = np.linspace(0, 2 * np.pi, 13)
-    expected = 2.0 * np.cos(phi) ** 2 / 1.5**2 + 2.0 * np.sin(phi) ** 2 / 0.7**2      # a cos^2/b^2 + a sin^2/c^2
+    expected = 2.0 * np.cos(phi) ** 2 / 1.5**2 + 2.0 * np.sin(phi) ** 2 / 0.7**2  # a cos^2/b^2 + a sin^2/c^2
     assert np.allclose(symbolic.ellipsoid_normal_curvature(2.0, 1.5, 0.7, phi), expected, rtol=1e-12)
     # at a generic point the numbers agree with the library's form of the same ellipsoid
     I_num, II_num = symbolic.ellipsoid_forms(2.0, 1.5, 0.7, 0.7, 1.0)

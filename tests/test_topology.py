@@ -1,9 +1,9 @@
 """Tests for geomlib.topology: closed-form counts, orientation laws, course meshes."""
 
-
 import numpy as np
 import pytest
 import trimesh
+from meshdata import COURSE, needs_course
 
 from geomlib import (
     MeshError,
@@ -18,8 +18,6 @@ from geomlib import (
     valence,
     vertex_face_adjacency,
 )
-from meshdata import COURSE, needs_course
-
 
 # ---------------------------------------------------------------- small meshes
 

@@ -1,13 +1,12 @@
 """Tests for geomlib.validate: as_mesh at the door, check_mesh and MeshReport."""
 
-
 import numpy as np
 import pytest
 import trimesh
+from meshdata import COURSE, needs_course
 
 from geomlib import MeshError, MeshReport, check_mesh, load_mesh
 from geomlib.validate import as_faces, as_mesh
-from meshdata import COURSE, needs_course
 
 
 def icosahedron():
@@ -93,7 +92,9 @@ def test_as_mesh_indices_out_of_range():
 def test_as_mesh_repeated_vertex_names_the_faces():
     V, F = tetrahedron()
     F = np.vstack([F, [[1, 1, 2], [3, 0, 3]]])
-    with pytest.raises(MeshError, match=r"2 faces repeat a vertex.*face 4 = \[1, 1, 2\], face 5 = \[3, 0, 3\]; faces 4, 5"):
+    with pytest.raises(
+        MeshError, match=r"2 faces repeat a vertex.*face 4 = \[1, 1, 2\], face 5 = \[3, 0, 3\]; faces 4, 5"
+    ):
         as_mesh(V, F)
 
 
@@ -201,7 +202,9 @@ def test_inconsistent_orientation():
     assert {tuple(e) for e in r.inconsistent_edges.tolist()} == flipped
     assert not r.is_oriented and r.genus is None
     assert len(r.non_manifold_vertices) == 0
-    assert any("inconsistent orientation" in p and "unsigned H, K and the Laplacians still work" in p for p in r.problems)
+    assert any(
+        "inconsistent orientation" in p and "unsigned H, K and the Laplacians still work" in p for p in r.problems
+    )
 
 
 def test_components_unreferenced_and_duplicates():
@@ -254,8 +257,9 @@ def test_camel_has_exactly_one_non_manifold_vertex():
 
 
 @needs_course
-@pytest.mark.parametrize("name, loops", [("cow_manifold2.obj", [16]), ("cow_small_manifold2.obj", [6]),
-                                         ("curvatures/lilium_s.obj", [70])])
+@pytest.mark.parametrize(
+    "name, loops", [("cow_manifold2.obj", [16]), ("cow_small_manifold2.obj", [6]), ("curvatures/lilium_s.obj", [70])]
+)
 def test_course_boundary_loops(name, loops):
     r = load_mesh(COURSE / name, report=True)[2]
     assert r.boundary_loop_lengths == loops and r.ok and r.genus == 0

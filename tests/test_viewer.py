@@ -17,8 +17,7 @@ import trimesh
 from PIL import Image
 
 from geomlib import MeshError
-from geomlib.viewer import (NAN_COLOR, MeshView, colorize, render_still, side_by_side,
-                            value_range, vertex_normals_fast)
+from geomlib.viewer import NAN_COLOR, MeshView, colorize, render_still, side_by_side, value_range, vertex_normals_fast
 
 
 @pytest.fixture(scope="module")
@@ -44,6 +43,7 @@ def messages(monkeypatch):
 
 # --- colour mapping ---------------------------------------------------------
 
+
 def test_colorize_maps_ends_middle_and_clips():
     cm = matplotlib.colormaps["viridis"]
     values = np.array([0.0, 5.0, 10.0, -3.0, 12.0])
@@ -51,9 +51,9 @@ def test_colorize_maps_ends_middle_and_clips():
     assert colors.shape == (5, 3) and colors.dtype == np.float32
     np.testing.assert_allclose(colors[0], cm(0.0)[:3], atol=1e-6)
     np.testing.assert_allclose(colors[2], cm(1.0)[:3], atol=1e-6)
-    np.testing.assert_allclose(colors[1], cm(0.5)[:3], atol=1 / 255 * 2)   # 256-entry table
-    np.testing.assert_allclose(colors[3], colors[0])                       # clipped below
-    np.testing.assert_allclose(colors[4], colors[2])                       # clipped above
+    np.testing.assert_allclose(colors[1], cm(0.5)[:3], atol=1 / 255 * 2)  # 256-entry table
+    np.testing.assert_allclose(colors[3], colors[0])  # clipped below
+    np.testing.assert_allclose(colors[4], colors[2])  # clipped above
 
 
 def test_nan_is_grey_and_counted(sphere):
@@ -72,11 +72,11 @@ def test_nan_is_grey_and_counted(sphere):
 
 def test_symmetric_range_is_centred_on_zero(sphere):
     V, F = sphere
-    values = 3.0 * V[:, 1].clip(0, None) - 1.0 * V[:, 1].clip(None, 0) ** 2   # in [-1, 3]
+    values = 3.0 * V[:, 1].clip(0, None) - 1.0 * V[:, 1].clip(None, 0) ** 2  # in [-1, 3]
     assert value_range(values, symmetric=True) == pytest.approx((-3.0, 3.0))
     assert value_range(values, symmetric=True, vmin=-0.5, vmax=2.0) == (-2.0, 2.0)
     view = MeshView(V, F, values=values, symmetric=True)
-    assert view.cmap == "RdBu_r"                  # diverging by default for signed values
+    assert view.cmap == "RdBu_r"  # diverging by default for signed values
     assert view.range == pytest.approx((-3.0, 3.0))
     middle = matplotlib.colormaps["RdBu_r"](0.5)[:3]
     zero = colorize(np.array([0.0]), "RdBu_r", *view.range)[0]
@@ -102,10 +102,11 @@ def test_colour_bar_shows_the_range_and_label(sphere):
     text = view._colorbar.value
     assert "linear-gradient" in text and "height (length)" in text
     assert ">-2<" in text and ">2<" in text
-    assert MeshView(V, F)._colorbar.layout.display == "none"   # no values, no colour bar
+    assert MeshView(V, F)._colorbar.layout.display == "none"  # no values, no colour bar
 
 
 # --- updates ----------------------------------------------------------------
+
 
 def test_update_overwrites_buffers_in_place_with_one_message(sphere, messages):
     V, F = sphere
@@ -119,7 +120,7 @@ def test_update_overwrites_buffers_in_place_with_one_message(sphere, messages):
     W = 1.5 * V
     view.update(V=W, values=W[:, 1])
 
-    assert messages == [("InterleavedBuffer", ["array"])]        # one message, one widget
+    assert messages == [("InterleavedBuffer", ["array"])]  # one message, one widget
     assert view.geometry.index is index
     for name, attribute in view.geometry.attributes.items():
         assert attribute is attributes[name]
@@ -152,6 +153,7 @@ def test_auto_range_follows_values(sphere):
 
 # --- normals ----------------------------------------------------------------
 
+
 def test_normals_on_a_sphere_are_radial():
     m = trimesh.creation.icosphere(subdivisions=4, radius=1.0)  # 2562 vertices
     V, F = np.asarray(m.vertices), np.asarray(m.faces)
@@ -176,6 +178,7 @@ def test_normals_flip_with_orientation(sphere):
 
 # --- display ----------------------------------------------------------------
 
+
 def _decode(bundle):
     return np.asarray(Image.open(io.BytesIO(base64.b64decode(bundle["image/png"]))).convert("RGB"))
 
@@ -191,8 +194,8 @@ def test_mimebundle_has_widget_png_and_text(sphere):
     pixels = image.reshape(-1, 3)
     not_white = np.any(pixels < 245, axis=1).mean()
     assert not_white > 0.1
-    assert len(np.unique(pixels, axis=0)) > 200              # shaded and coloured, not flat
-    reds = (pixels[:, 0] > pixels[:, 2] + 60).mean()         # the diverging map shows both ends
+    assert len(np.unique(pixels, axis=0)) > 200  # shaded and coloured, not flat
+    reds = (pixels[:, 0] > pixels[:, 2] + 60).mean()  # the diverging map shows both ends
     blues = (pixels[:, 2] > pixels[:, 0] + 60).mean()
     assert reds > 0.01 and blues > 0.01
     assert "642 vertices" in bundle["text/plain"] and "1280 faces" in bundle["text/plain"]
@@ -209,7 +212,7 @@ def test_still_puts_the_mesh_in_the_middle():
     colors = np.tile([1.0, 0.0, 0.0], (4, 1))
     image = render_still(corners, F, colors, width=100, height=80)
     assert image.shape == (80, 100, 3)
-    assert image[40, 50, 0] > 200 and image[40, 50, 1] < 40     # red, lit head-on
+    assert image[40, 50, 0] > 200 and image[40, 50, 1] < 40  # red, lit head-on
     assert (image[0, 0] == 255).all() and (image[-1, -1] == 255).all()
     # nearer surfaces hide farther ones: a blue square in front covers the red one
     V2 = np.vstack([corners, 0.5 * corners + 0.5 * w])
@@ -225,13 +228,14 @@ def test_plain_view_without_values(sphere):
     assert view.wireframe is not None
     assert view.wireframe.geometry.attributes["position"] is view.geometry.attributes["position"]
     n_edges = len(view.wireframe.geometry.index.array) // 2
-    assert n_edges == 3 * len(F) // 2                       # closed mesh: E = 3F/2
+    assert n_edges == 3 * len(F) // 2  # closed mesh: E = 3F/2
     assert "coloured" not in view.summary()
     image = view.still()
     assert np.any(image < 245, axis=2).mean() > 0.1
 
 
 # --- side by side -----------------------------------------------------------
+
 
 def test_side_by_side_links_cameras(sphere):
     V, F = sphere
@@ -247,7 +251,7 @@ def test_side_by_side_links_cameras(sphere):
     assert [child for child in row.widget.children] == [a.widget, b.widget, c.widget]
     # the shared camera is framed on the largest mesh
     assert np.linalg.norm(a.camera.position) == pytest.approx(row._distance)
-    assert row._distance > MeshView(V, F)._distance          # b is twice as large
+    assert row._distance > MeshView(V, F)._distance  # b is twice as large
     bundle = row._repr_mimebundle_()
     image = _decode(bundle)
     assert image.shape[1] == 3 * a.width + 2 * 8
@@ -263,10 +267,14 @@ def test_side_by_side_without_linking_keeps_cameras(sphere):
 
 # --- bad input --------------------------------------------------------------
 
-@pytest.mark.parametrize("V_bad, message", [
-    (np.zeros((5, 2)), "shape"),
-    (np.zeros(15), "shape"),
-])
+
+@pytest.mark.parametrize(
+    "V_bad, message",
+    [
+        (np.zeros((5, 2)), "shape"),
+        (np.zeros(15), "shape"),
+    ],
+)
 def test_bad_vertex_shapes(V_bad, message, sphere):
     _, F = sphere
     with pytest.raises(MeshError, match=message):
@@ -319,20 +327,21 @@ def test_values_of_wrong_length(sphere):
 def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
     V, F = sphere
     assert MeshView(V, F).mesh.material.side == "FrontSide"
-    assert MeshView(V, F[:, ::-1]).mesh.material.side == "DoubleSide"      # inside out
+    assert MeshView(V, F[:, ::-1]).mesh.material.side == "DoubleSide"  # inside out
     G = F.copy()
-    G[0] = G[0, ::-1]                                                       # one face flipped
+    G[0] = G[0, ::-1]  # one face flipped
     assert MeshView(V, G).mesh.material.side == "DoubleSide"
-    assert MeshView(V, F[1:]).mesh.material.side == "DoubleSide"            # a hole
+    assert MeshView(V, F[1:]).mesh.material.side == "DoubleSide"  # a hole
 
 
 # --- pictures that must not mislead ----------------------------------------
+
 
 def test_a_field_zero_up_to_rounding_draws_white(sphere):
     from geomlib.viewer import ZERO_COLOR
 
     V, F = sphere
-    rounding = 8e-13 * np.sin(7 * V[:, 0])              # a flat mesh's H, say: zero but for rounding
+    rounding = 8e-13 * np.sin(7 * V[:, 0])  # a flat mesh's H, say: zero but for rounding
     view = MeshView(V, F, values=rounding, symmetric=True, label="H (1/length)")
     assert view.is_zero
     np.testing.assert_array_equal(view.colors, np.tile(np.float32(ZERO_COLOR), (len(V), 1)))
@@ -358,14 +367,16 @@ def test_zero_field_keeps_nan_grey(sphere):
 
 def test_frame_keeps_a_collapsed_mesh_at_the_input_scale(sphere):
     V, F = sphere
-    collapsed = 0.01 * V + 0.3                            # what a collapsing flow leaves
+    collapsed = 0.01 * V + 0.3  # what a collapsing flow leaves
     own = MeshView(collapsed, F)
     framed = MeshView(collapsed, F, frame=V)
     assert framed._distance == pytest.approx(MeshView(V, F)._distance)
     assert own._distance == pytest.approx(0.01 * framed._distance)
+
     # in the still, the collapsed mesh covers a small fraction of what the input covers
     def covered(view):
-        return np.any(view.still()[:view.height] < 245, axis=2).mean()
+        return np.any(view.still()[: view.height] < 245, axis=2).mean()
+
     assert covered(framed) < 0.01 * covered(MeshView(V, F))
     assert covered(own) > 0.5 * covered(MeshView(V, F))
     # updating to the collapsed positions does not reframe either
@@ -377,21 +388,21 @@ def test_frame_keeps_a_collapsed_mesh_at_the_input_scale(sphere):
 
 def test_linked_views_of_very_different_sizes_are_not_specks(sphere):
     V, F = sphere
-    big = 28.0 * V                                        # fandisk_ns is 28 times plane_ns
-    small_V, small_F = V[:, :], F[:, ::-1].copy()         # another mesh (other faces)
+    big = 28.0 * V  # fandisk_ns is 28 times plane_ns
+    small_V, small_F = V[:, :], F[:, ::-1].copy()  # another mesh (other faces)
     a, b = MeshView(big, F, title="large"), MeshView(small_V, small_F, title="small")
     row = side_by_side(a, b)
     assert a._scale == 1.0 and b._scale == pytest.approx(28.0)
     assert b.mesh.scale == pytest.approx((28.0, 28.0, 28.0))
     assert "28 x larger" in b._title.value and "larger" not in a._title.value
     assert "28 x larger" in b.summary()
-    covered = [np.any(v.still(distance=row._distance)[18:18 + v.height] < 245, axis=2).mean() for v in row.views]
+    covered = [np.any(v.still(distance=row._distance)[18 : 18 + v.height] < 245, axis=2).mean() for v in row.views]
     assert covered[1] > 0.5 * covered[0]
 
 
 def test_linked_views_of_one_mesh_keep_their_common_scale(sphere):
     V, F = sphere
-    before, after = MeshView(V, F), MeshView(0.05 * V, F)   # the same mesh before and after shrinking
+    before, after = MeshView(V, F), MeshView(0.05 * V, F)  # the same mesh before and after shrinking
     side_by_side(before, after)
     assert before._scale == after._scale == 1.0
     # similar sizes are never rescaled

@@ -44,8 +44,11 @@ def stub_source(source, exercise, reread):
 
 def solution_cells(nb):
     """The (index, cell) pairs marked as nbgrader solution cells."""
-    return [(i, c) for i, c in enumerate(nb.cells)
-            if c.cell_type == "code" and c.metadata.get("nbgrader", {}).get("solution")]
+    return [
+        (i, c)
+        for i, c in enumerate(nb.cells)
+        if c.cell_type == "code" and c.metadata.get("nbgrader", {}).get("solution")
+    ]
 
 
 def build(out):
@@ -63,8 +66,11 @@ def build(out):
                 raise SystemExit(f"{path.name}: solution cell {exercise!r} names no check in geomlib.check")
             cell.source = stub_source(cell.source, exercise, checker.reread)
         for cell in nb.cells:
-            if cell.cell_type == "code" and (BEGIN in cell.source or END in cell.source) \
-                    and not cell.metadata.get("nbgrader", {}).get("solution"):
+            if (
+                cell.cell_type == "code"
+                and (BEGIN in cell.source or END in cell.source)
+                and not cell.metadata.get("nbgrader", {}).get("solution")
+            ):
                 raise SystemExit(f"{path.name}: solution markers in a cell without nbgrader solution metadata")
         nbformat.write(nb, out / path.name)
         written.append(path.name)

@@ -53,38 +53,62 @@ REGISTRY = "https://registry.npmjs.org"
 #: jupyter-datawidgets 5.5.2 that of ipydatawidgets 4.3.5.
 PACKAGES = {
     "requirejs": (
-        "2.3.7", "sha512-DouTG8T1WanGok6Qjg2SXuCMzszOo0eHeH9hDZ5Y4x8Je+9JB38HdTLT4/VA8OaUhBa0JPVHJ0pyBkM1z+pDsw==",
-        ["require.js", "LICENSE"], "requirejs"),
+        "2.3.7",
+        "sha512-DouTG8T1WanGok6Qjg2SXuCMzszOo0eHeH9hDZ5Y4x8Je+9JB38HdTLT4/VA8OaUhBa0JPVHJ0pyBkM1z+pDsw==",
+        ["require.js", "LICENSE"],
+        "requirejs",
+    ),
     "@jupyter-widgets/html-manager": (
-        "1.0.15", "sha512-5thBIV6ymNgmPVOHvzx+gGy8ZSKmSazhtGw4/c4xJDVzRhG9PTeQsRjF3FUTopvFi//SABeNz1yp47bCrJ3CQA==",
+        "1.0.15",
+        "sha512-5thBIV6ymNgmPVOHvzx+gGy8ZSKmSazhtGw4/c4xJDVzRhG9PTeQsRjF3FUTopvFi//SABeNz1yp47bCrJ3CQA==",
         # its style sheet lists each icon font in several formats; browsers take the woff2
-        ["dist/embed-amd.js", "dist/*.woff2", "dist/*.woff", "dist/*.LICENSE.txt", "LICENSE"], "html-manager"),
+        ["dist/embed-amd.js", "dist/*.woff2", "dist/*.woff", "dist/*.LICENSE.txt", "LICENSE"],
+        "html-manager",
+    ),
     "jupyter-threejs": (
-        "2.4.1", "sha512-AFoYllRmV5Hy1Hbyq8NR09KXiFE+9qQ4zPlKW5RAzkRjdvO56rWM4hzSKNSnW/GH/8FcqMVE2SnGHOP/ZmFwSw==",
-        ["dist/index.js", "dist/*.LICENSE.txt", "LICENSE"], "jupyter-threejs"),
+        "2.4.1",
+        "sha512-AFoYllRmV5Hy1Hbyq8NR09KXiFE+9qQ4zPlKW5RAzkRjdvO56rWM4hzSKNSnW/GH/8FcqMVE2SnGHOP/ZmFwSw==",
+        ["dist/index.js", "dist/*.LICENSE.txt", "LICENSE"],
+        "jupyter-threejs",
+    ),
     "jupyter-datawidgets": (
-        "5.5.2", "sha512-gRNoe9I21veWAr78+4bzjUuhwuI5VmdSphTepUUB5AHNN1etxr9qpql0Gug41CO085HuzqxLUXF4zCMIoXUZpQ==",
-        ["dist/index.js", "LICENSE*"], "jupyter-datawidgets"),
+        "5.5.2",
+        "sha512-gRNoe9I21veWAr78+4bzjUuhwuI5VmdSphTepUUB5AHNN1etxr9qpql0Gug41CO085HuzqxLUXF4zCMIoXUZpQ==",
+        ["dist/index.js", "LICENSE*"],
+        "jupyter-datawidgets",
+    ),
     "mathjax": (
-        "2.7.9", "sha512-NOGEDTIM9+MrsqnjPEjVGNx4q0GQxqm61yQwSK+/5S59i26wId5IC5gNu9/bu8+CCVl5p9G2IHcAl/wJa+5+BQ==",
+        "2.7.9",
+        "sha512-NOGEDTIM9+MrsqnjPEjVGNx4q0GQxqm61yQwSK+/5S59i26wId5IC5gNu9/bu8+CCVl5p9G2IHcAl/wJa+5+BQ==",
         # what config=TeX-AMS_CHTML-full,Safe loads: TeX in, CommonHTML out with its web fonts
-        ["MathJax.js", "config/TeX-AMS_CHTML-full.js", "config/Safe.js", "extensions/*.js",
-         "extensions/TeX/*", "jax/input/TeX/**", "jax/output/CommonHTML/**", "jax/element/**",
-         "fonts/HTML-CSS/TeX/woff/*", "LICENSE"], "mathjax"),
+        [
+            "MathJax.js",
+            "config/TeX-AMS_CHTML-full.js",
+            "config/Safe.js",
+            "extensions/*.js",
+            "extensions/TeX/*",
+            "jax/input/TeX/**",
+            "jax/output/CommonHTML/**",
+            "jax/element/**",
+            "fonts/HTML-CSS/TeX/woff/*",
+            "LICENSE",
+        ],
+        "mathjax",
+    ),
 }
 
 REQUIRE_JS = f"{ASSETS}/requirejs/require.js"
 WIDGET_RENDERER = f"{ASSETS}/html-manager/dist/embed-amd.js"
 MATHJAX = f"{ASSETS}/mathjax/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
-AMD_PATHS = {"jupyter-threejs": f"{ASSETS}/jupyter-threejs/dist/index",
-             "jupyter-datawidgets": f"{ASSETS}/jupyter-datawidgets/dist/index"}
+AMD_PATHS = {
+    "jupyter-threejs": f"{ASSETS}/jupyter-threejs/dist/index",
+    "jupyter-datawidgets": f"{ASSETS}/jupyter-datawidgets/dist/index",
+}
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
-KERNEL_NOTE = ("In JupyterLab this control recomputes the result; "
-               "on this page it stays at its default value.")
-KERNEL_NOTE_MANY = ("In JupyterLab these controls recompute the result; "
-                    "on this page they stay at their default values.")
+KERNEL_NOTE = "In JupyterLab this control recomputes the result; on this page it stays at its default value."
+KERNEL_NOTE_MANY = "In JupyterLab these controls recompute the result; on this page they stay at their default values."
 
 # ---------------------------------------------------------------------------
 # the pinned JavaScript
@@ -105,8 +129,10 @@ def fetch_tarball(name, version, integrity):
             data = response.read()
     actual = base64.b64encode(hashlib.new(algorithm, data).digest()).decode()
     if actual != expected:
-        raise SystemExit(f"{name}@{version}: the download does not match its pinned {algorithm} "
-                         f"hash ({actual} != {expected}); delete {path} and try again")
+        raise SystemExit(
+            f"{name}@{version}: the download does not match its pinned {algorithm} "
+            f"hash ({actual} != {expected}); delete {path} and try again"
+        )
     if not cached:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
@@ -126,7 +152,7 @@ def install_assets(site):
         patterns = [glob_pattern(g) for g in keep]
         with tarfile.open(fileobj=io.BytesIO(fetch_tarball(name, version, integrity)), mode="r:gz") as tar:
             for member in tar.getmembers():
-                rel = member.name.split("/", 1)[1]   # members sit under "package/"
+                rel = member.name.split("/", 1)[1]  # members sit under "package/"
                 if member.isfile() and any(g.fullmatch(rel) for g in patterns):
                     dest = target / rel
                     dest.parent.mkdir(parents=True, exist_ok=True)
@@ -148,17 +174,27 @@ def execute(path, timeout=1200):
     from nbclient import NotebookClient
 
     nb = nbformat.read(path, as_version=4)
-    client = NotebookClient(nb, timeout=timeout, kernel_name="python3", store_widget_state=True,
-                            allow_errors=True, resources={"metadata": {"path": str(path.parent)}})
+    client = NotebookClient(
+        nb,
+        timeout=timeout,
+        kernel_name="python3",
+        store_widget_state=True,
+        allow_errors=True,
+        resources={"metadata": {"path": str(path.parent)}},
+    )
     client.execute()
     return nb
 
 
 def cell_errors(nb):
     """``"cell N: Name: message"`` for every error output of an executed notebook (N from 0)."""
-    return [f"cell {i}: {out.get('ename', '?')}: {out.get('evalue', '')}".strip()
-            for i, cell in enumerate(nb.cells) if cell.cell_type == "code"
-            for out in cell.get("outputs", []) if out.get("output_type") == "error"]
+    return [
+        f"cell {i}: {out.get('ename', '?')}: {out.get('evalue', '')}".strip()
+        for i, cell in enumerate(nb.cells)
+        if cell.cell_type == "code"
+        for out in cell.get("outputs", [])
+        if out.get("output_type") == "error"
+    ]
 
 
 def _references(value):
@@ -223,8 +259,12 @@ def prepare_for_site(nb):
             renderers = sum(state[m].get("model_name") == "RendererModel" for m in models)
             live += renderers
             if renderers and "image/png" in output["data"]:
-                outputs.append(_html_output(f'<img class="site-still" hidden alt="still picture of the 3D view" '
-                                            f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'))
+                outputs.append(
+                    _html_output(
+                        f'<img class="site-still" hidden alt="still picture of the 3D view" '
+                        f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'
+                    )
+                )
             controls = sum(_is_control(state[m]) for m in models)
             if controls:
                 note = KERNEL_NOTE if controls == 1 else KERNEL_NOTE_MANY
@@ -306,9 +346,13 @@ def exporter():
     from nbconvert import HTMLExporter
 
     template = TEMPLATE.replace("%(paths)s", json.dumps(AMD_PATHS))
-    return HTMLExporter(extra_loaders=[DictLoader({"site.html.j2": template})], template_file="site.html.j2",
-                        require_js_url=REQUIRE_JS, widget_renderer_url=WIDGET_RENDERER,
-                        mathjax_url=MATHJAX)
+    return HTMLExporter(
+        extra_loaders=[DictLoader({"site.html.j2": template})],
+        template_file="site.html.j2",
+        require_js_url=REQUIRE_JS,
+        widget_renderer_url=WIDGET_RENDERER,
+        mathjax_url=MATHJAX,
+    )
 
 
 def nav_html(pages, i):
@@ -316,8 +360,10 @@ def nav_html(pages, i):
         if 0 <= j < len(pages):
             return f'<a href="{pages[j]["file"]}">{label} {html.escape(pages[j]["title"])}</a>'
         return "<span></span>"
-    return (f'<nav class="site-nav">{link(i - 1, "&larr;")}<a href="index.html">Contents</a>'
-            f'{link(i + 1, "&rarr;")}</nav>')
+
+    return (
+        f'<nav class="site-nav">{link(i - 1, "&larr;")}<a href="index.html">Contents</a>{link(i + 1, "&rarr;")}</nav>'
+    )
 
 
 INDEX = """<!DOCTYPE html>
@@ -349,8 +395,9 @@ def build(out=OUT, names=None, log=print):
     paths = [NOTEBOOKS / Path(n).name for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
     if out.exists() and any(out.iterdir()):
         if not (out / "pages.json").exists():
-            raise SystemExit(f"{out} is not empty and holds no earlier build of the site; "
-                             "choose an empty or new folder")
+            raise SystemExit(
+                f"{out} is not empty and holds no earlier build of the site; choose an empty or new folder"
+            )
         shutil.rmtree(out)
     out.mkdir(parents=True, exist_ok=True)
     install_assets(out)
@@ -361,22 +408,33 @@ def build(out=OUT, names=None, log=print):
         log(f"executing {path.name} ...")
         nb = execute(path)
         live = prepare_for_site(nb)
-        pages.append({"file": path.stem + ".html", "title": title_of(nb, path.stem), "views": live,
-                      "seconds": round(time.perf_counter() - start, 1), "errors": cell_errors(nb)})
+        pages.append(
+            {
+                "file": path.stem + ".html",
+                "title": title_of(nb, path.stem),
+                "views": live,
+                "seconds": round(time.perf_counter() - start, 1),
+                "errors": cell_errors(nb),
+            }
+        )
         executed.append(nb)
         log(f"  {pages[-1]['seconds']} s, {live} live 3D views")
         for error in pages[-1]["errors"]:
             log(f"  ERROR in {error}")
     page_exporter = exporter()
     for i, (page, nb) in enumerate(zip(pages, executed)):
-        body, _ = page_exporter.from_notebook_node(nb, resources={"site_nav": nav_html(pages, i),
-                                                             "metadata": {"name": page["title"]}})
+        body, _ = page_exporter.from_notebook_node(
+            nb, resources={"site_nav": nav_html(pages, i), "metadata": {"name": page["title"]}}
+        )
         (out / page["file"]).write_text(body, encoding="utf-8")
-    items = "\n".join(f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
-                      f'<span class="views">({p["views"]} live 3D view{"" if p["views"] == 1 else "s"})</span></li>'
-                      for p in pages)
-    (out / "index.html").write_text(INDEX.format(title="Discrete curvature and Laplacian mesh processing",
-                                                 items=items), encoding="utf-8")
+    items = "\n".join(
+        f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
+        f'<span class="views">({p["views"]} live 3D view{"" if p["views"] == 1 else "s"})</span></li>'
+        for p in pages
+    )
+    (out / "index.html").write_text(
+        INDEX.format(title="Discrete curvature and Laplacian mesh processing", items=items), encoding="utf-8"
+    )
     (out / "pages.json").write_text(json.dumps(pages, indent=1))
     return pages
 

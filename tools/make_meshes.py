@@ -294,8 +294,14 @@ def creature():
     axes = [lo[i] + h * np.arange(n[i]) for i in range(3)]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     field = creature_field(np.stack([X, Y, Z], axis=-1))
-    if field[0].min() <= 0 or field[-1].min() <= 0 or field[:, 0].min() <= 0 or field[:, -1].min() <= 0 \
-            or field[:, :, 0].min() <= 0 or field[:, :, -1].min() <= 0:
+    if (
+        field[0].min() <= 0
+        or field[-1].min() <= 0
+        or field[:, 0].min() <= 0
+        or field[:, -1].min() <= 0
+        or field[:, :, 0].min() <= 0
+        or field[:, :, -1].min() <= 0
+    ):
         raise MeshError("creature: the shape touches the sampling box")
     verts, faces, _, _ = marching_cubes(field, level=0.0, allow_degenerate=True, method="lewiner")
     # rule 1: clamp the fractional coordinate (grid units) away from the nodes
@@ -462,7 +468,11 @@ def cad_part():
     parts = []
     # end caps y = 0 (outward -y) and y = D (outward +y)
     for y, ny_sign in ((0.0, -1.0), (D, 1.0)):
-        parts.append(_planar_patch(ring, [], h, lambda P, y=y: np.stack([P[:, 0], np.full(len(P), y), P[:, 1]], 1), (0, ny_sign, 0)))
+        parts.append(
+            _planar_patch(
+                ring, [], h, lambda P, y=y: np.stack([P[:, 0], np.full(len(P), y), P[:, 1]], 1), (0, ny_sign, 0)
+            )
+        )
     cx, cy = CAD_BOSS["centre"]
     rad, bh = CAD_BOSS["radius"], CAD_BOSS["height"]
     ztop = 0.8
@@ -481,13 +491,19 @@ def cad_part():
             # the top face: a rectangle in (x, y) with the boss's hole
             xs = _segment_points(p0, p1, seg_n[i])[:, 0]
             ys = D * np.arange(ny + 1) / ny
-            rect = np.concatenate([
-                np.stack([xs[:-1], np.zeros(seg_n[i])], 1),
-                np.stack([np.full(ny, xs[-1]), ys[:-1]], 1),
-                np.stack([xs[::-1][:-1], np.full(seg_n[i], D)], 1),
-                np.stack([np.full(ny, xs[0]), ys[::-1][:-1]], 1),
-            ])
-            parts.append(_planar_patch(rect, [circle], h, lambda P: np.stack([P[:, 0], P[:, 1], np.full(len(P), ztop)], 1), (0, 0, 1)))
+            rect = np.concatenate(
+                [
+                    np.stack([xs[:-1], np.zeros(seg_n[i])], 1),
+                    np.stack([np.full(ny, xs[-1]), ys[:-1]], 1),
+                    np.stack([xs[::-1][:-1], np.full(seg_n[i], D)], 1),
+                    np.stack([np.full(ny, xs[0]), ys[::-1][:-1]], 1),
+                ]
+            )
+            parts.append(
+                _planar_patch(
+                    rect, [circle], h, lambda P: np.stack([P[:, 0], P[:, 1], np.full(len(P), ztop)], 1), (0, 0, 1)
+                )
+            )
         else:
             parts.append(_strip(p0, p1, 0.0, D, seg_n[i], ny, outward))
     # the boss: wall (structured) and top disk
@@ -500,7 +516,9 @@ def cad_part():
     flip = np.einsum("ij,ij->i", FN[:, :2], radial[Fw].mean(axis=1)) < 0
     Fw[flip] = Fw[flip][:, [0, 2, 1]]
     parts.append((wall, Fw))
-    parts.append(_planar_patch(circle, [], h, lambda P: np.stack([P[:, 0], P[:, 1], np.full(len(P), ztop + bh)], 1), (0, 0, 1)))
+    parts.append(
+        _planar_patch(circle, [], h, lambda P: np.stack([P[:, 0], P[:, 1], np.full(len(P), ztop + bh)], 1), (0, 0, 1))
+    )
     # stitch
     V = np.concatenate([p[0] for p in parts])
     offs = np.cumsum([0] + [len(p[0]) for p in parts[:-1]])
@@ -556,42 +574,91 @@ PLANE_N = 40
 NOISE_SIGMA = 0.005  # relative to the bounding-box diagonal
 
 SPECS = [
-    Spec("plane.obj", lambda: _from_surface(surfaces.plane(n=PLANE_N, size=2.0)),
-         f"`geomlib.surfaces.plane(n={PLANE_N}, size=2.0)`: regular grid on [-1, 1]^2, z = 0, each square split by the same diagonal. Exact H = K = 0.",
-         "01, 03: flat mesh, every curvature estimate should give 0", False),
-    Spec("plane_irregular.obj", lambda: _from_surface(surfaces.plane(n=PLANE_N, size=2.0, jitter=0.3, seed=1)),
-         f"`geomlib.surfaces.plane(n={PLANE_N}, size=2.0, jitter=0.3, seed=1)`: the same grid with every vertex moved in the plane by up to 0.3 grid steps (boundary vertices along their side). Exact H = K = 0.",
-         "01, 03: uniform weights see curvature on a flat but irregular mesh, cotan weights do not; the clean reference of plane_noisy.obj", False),
-    Spec("plane_noisy.obj", lambda: _noisy_plane(),
-         f"plane_irregular.obj (same vertex order and faces) with z = sigma d z_i, z_i ~ N(0, 1) from `numpy.random.default_rng(2)`, sigma = {NOISE_SIGMA} of the bounding-box diagonal d of the clean plane (noise along the normal, as `geomlib.add_noise(V, F, {NOISE_SIGMA}, seed, direction=\"normal\")` defines it).",
-         "05, 06, 07: smoothing and denoising an open mesh (the course's plane_ns role); compare with plane_irregular.obj", False),
-    Spec("saddle.obj", lambda: _from_surface(surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)),
-         "`geomlib.surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)`: z = 0.2 (27/4) x (1 - x^2) y (1 - y^2) + 0.1 (x^3 - 3 x y^2) over [-1, 1]^2, (x, y) jittered by up to 0.3 grid steps, z evaluated again. Exact truth: `geomlib.surfaces.attach_truth(\"saddle\", V, F)`.",
-         "01, 03: open curved surface with K < 0 and K > 0 regions, a boundary, and many obtuse triangles (mixed vs barycentric areas)", False),
-    Spec("sphere.obj", lambda: _from_surface(surfaces.sphere(1.0, subdivisions=4)),
-         "`geomlib.surfaces.sphere(1.0, subdivisions=4)`: icosphere of radius 1. Exact H = 1, K = 1.",
-         "00, 01, 03: H = 1/r, Gauss-Bonnet (integral of K = 4 pi)", True),
-    Spec("ellipsoid.obj", lambda: _from_surface(surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)),
-         "`geomlib.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)`: the icosphere mapped by (x, y, z) -> (a x, b y, c z), a, b, c = 1.0, 0.7, 0.5. Exact truth: `geomlib.surfaces.attach_truth(\"ellipsoid\", V, F, a=1.0, b=0.7, c=0.5)` (from geomlib.symbolic).",
-         "02, 03: discrete curvature against the exact curvature of the fundamental forms", True),
-    Spec("ellipsoid_jittered.obj", lambda: _from_surface(surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)),
-         "`geomlib.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)`: the same surface, every vertex moved along the surface by up to 0.3 of its mean edge length (on the unit sphere, before the map). Same exact truth.",
-         "03: the same comparison on an irregular tessellation (uniform weights break down, cotan weights hold)", True),
-    Spec("torus.obj", lambda: _from_surface(surfaces.torus(1.0, 0.4, n=80, m=32)),
-         "`geomlib.surfaces.torus(1.0, 0.4, n=80, m=32)`: R = 1, r = 0.4, an 80 x 32 grid in (u, v), no seam duplicates. Exact truth: `geomlib.surfaces.attach_truth(\"torus\", V, F, R=1.0, r=0.4)`.",
-         "01, 03: K of both signs, Gauss-Bonnet with Euler characteristic 0", True),
-    Spec("creature.obj", lambda: creature(),
-         f"Marching cubes (`skimage.measure.marching_cubes`, Lewiner, grid step {CREATURE_SPACING}) of a smooth union (polynomial smooth minimum, width {CREATURE_BLEND}) of ellipsoids (body, head, snout, ears) and capsules (neck, four legs, a two-piece tail); clean-up: vertices clamped to at least {CREATURE_CLAMP} grid steps from grid nodes along their grid edge (removes zero-area and needle triangles), coincident vertices merged, faces turned outwards; checked to be one closed, manifold, consistently oriented component with Euler characteristic 2. See `creature()` in tools/make_meshes.py.",
-         "04: spectral reconstruction from k Laplacian eigenvectors (limbs appear as k grows)", True, expensive=True),
-    Spec("cad_part.obj", lambda: cad_part(),
-         "A 2.0 x 1.2 x 0.8 block: the profile (x, z) = (0, 0), (2, 0), (2, 0.5), (1.7, 0.8), (0.8, 0.8), (0, 0.4) (a 45-degree chamfer and a slanted roof face) extruded along y by 1.2, with a cylindrical boss (radius 0.3, height 0.35) on the top face. Flat strips and the boss wall are structured grids, end caps, top face and boss top are Delaunay triangulations of boundary points plus a triangular lattice (target edge 0.04); faces share their boundary points, so the edges are exact sharp creases. See `cad_part()` in tools/make_meshes.py.",
-         "05, 06, 07: sharp features under smoothing and denoising (the course's fandisk role); the clean reference of cad_part_noisy.obj", True),
-    Spec("cad_part_noisy.obj", lambda: _noisy_cad(),
-         f"cad_part.obj (same vertex order and faces) with noise sigma d z_i n_i along the area-weighted vertex normals n_i, z_i ~ N(0, 1) from `numpy.random.default_rng(5)`, sigma = {NOISE_SIGMA} of the bounding-box diagonal d.",
-         "05, 06, 07: denoising with sharp edges; compare with cad_part.obj", True),
-    Spec("cube.obj", lambda: cube(),
-         "The cube [-0.5, 0.5]^3, 8 vertices, 12 triangles (two per face), outward.",
-         "05, 06: the handout's simple cube (smoothing shrinks it towards a sphere, then a point)", True),
+    Spec(
+        "plane.obj",
+        lambda: _from_surface(surfaces.plane(n=PLANE_N, size=2.0)),
+        f"`geomlib.surfaces.plane(n={PLANE_N}, size=2.0)`: regular grid on [-1, 1]^2, z = 0, each square split by the same diagonal. Exact H = K = 0.",
+        "01, 03: flat mesh, every curvature estimate should give 0",
+        False,
+    ),
+    Spec(
+        "plane_irregular.obj",
+        lambda: _from_surface(surfaces.plane(n=PLANE_N, size=2.0, jitter=0.3, seed=1)),
+        f"`geomlib.surfaces.plane(n={PLANE_N}, size=2.0, jitter=0.3, seed=1)`: the same grid with every vertex moved in the plane by up to 0.3 grid steps (boundary vertices along their side). Exact H = K = 0.",
+        "01, 03: uniform weights see curvature on a flat but irregular mesh, cotan weights do not; the clean reference of plane_noisy.obj",
+        False,
+    ),
+    Spec(
+        "plane_noisy.obj",
+        lambda: _noisy_plane(),
+        f'plane_irregular.obj (same vertex order and faces) with z = sigma d z_i, z_i ~ N(0, 1) from `numpy.random.default_rng(2)`, sigma = {NOISE_SIGMA} of the bounding-box diagonal d of the clean plane (noise along the normal, as `geomlib.add_noise(V, F, {NOISE_SIGMA}, seed, direction="normal")` defines it).',
+        "05, 06, 07: smoothing and denoising an open mesh (the course's plane_ns role); compare with plane_irregular.obj",
+        False,
+    ),
+    Spec(
+        "saddle.obj",
+        lambda: _from_surface(surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)),
+        '`geomlib.surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)`: z = 0.2 (27/4) x (1 - x^2) y (1 - y^2) + 0.1 (x^3 - 3 x y^2) over [-1, 1]^2, (x, y) jittered by up to 0.3 grid steps, z evaluated again. Exact truth: `geomlib.surfaces.attach_truth("saddle", V, F)`.',
+        "01, 03: open curved surface with K < 0 and K > 0 regions, a boundary, and many obtuse triangles (mixed vs barycentric areas)",
+        False,
+    ),
+    Spec(
+        "sphere.obj",
+        lambda: _from_surface(surfaces.sphere(1.0, subdivisions=4)),
+        "`geomlib.surfaces.sphere(1.0, subdivisions=4)`: icosphere of radius 1. Exact H = 1, K = 1.",
+        "00, 01, 03: H = 1/r, Gauss-Bonnet (integral of K = 4 pi)",
+        True,
+    ),
+    Spec(
+        "ellipsoid.obj",
+        lambda: _from_surface(surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)),
+        '`geomlib.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)`: the icosphere mapped by (x, y, z) -> (a x, b y, c z), a, b, c = 1.0, 0.7, 0.5. Exact truth: `geomlib.surfaces.attach_truth("ellipsoid", V, F, a=1.0, b=0.7, c=0.5)` (from geomlib.symbolic).',
+        "02, 03: discrete curvature against the exact curvature of the fundamental forms",
+        True,
+    ),
+    Spec(
+        "ellipsoid_jittered.obj",
+        lambda: _from_surface(surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)),
+        "`geomlib.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)`: the same surface, every vertex moved along the surface by up to 0.3 of its mean edge length (on the unit sphere, before the map). Same exact truth.",
+        "03: the same comparison on an irregular tessellation (uniform weights break down, cotan weights hold)",
+        True,
+    ),
+    Spec(
+        "torus.obj",
+        lambda: _from_surface(surfaces.torus(1.0, 0.4, n=80, m=32)),
+        '`geomlib.surfaces.torus(1.0, 0.4, n=80, m=32)`: R = 1, r = 0.4, an 80 x 32 grid in (u, v), no seam duplicates. Exact truth: `geomlib.surfaces.attach_truth("torus", V, F, R=1.0, r=0.4)`.',
+        "01, 03: K of both signs, Gauss-Bonnet with Euler characteristic 0",
+        True,
+    ),
+    Spec(
+        "creature.obj",
+        lambda: creature(),
+        f"Marching cubes (`skimage.measure.marching_cubes`, Lewiner, grid step {CREATURE_SPACING}) of a smooth union (polynomial smooth minimum, width {CREATURE_BLEND}) of ellipsoids (body, head, snout, ears) and capsules (neck, four legs, a two-piece tail); clean-up: vertices clamped to at least {CREATURE_CLAMP} grid steps from grid nodes along their grid edge (removes zero-area and needle triangles), coincident vertices merged, faces turned outwards; checked to be one closed, manifold, consistently oriented component with Euler characteristic 2. See `creature()` in tools/make_meshes.py.",
+        "04: spectral reconstruction from k Laplacian eigenvectors (limbs appear as k grows)",
+        True,
+        expensive=True,
+    ),
+    Spec(
+        "cad_part.obj",
+        lambda: cad_part(),
+        "A 2.0 x 1.2 x 0.8 block: the profile (x, z) = (0, 0), (2, 0), (2, 0.5), (1.7, 0.8), (0.8, 0.8), (0, 0.4) (a 45-degree chamfer and a slanted roof face) extruded along y by 1.2, with a cylindrical boss (radius 0.3, height 0.35) on the top face. Flat strips and the boss wall are structured grids, end caps, top face and boss top are Delaunay triangulations of boundary points plus a triangular lattice (target edge 0.04); faces share their boundary points, so the edges are exact sharp creases. See `cad_part()` in tools/make_meshes.py.",
+        "05, 06, 07: sharp features under smoothing and denoising (the course's fandisk role); the clean reference of cad_part_noisy.obj",
+        True,
+    ),
+    Spec(
+        "cad_part_noisy.obj",
+        lambda: _noisy_cad(),
+        f"cad_part.obj (same vertex order and faces) with noise sigma d z_i n_i along the area-weighted vertex normals n_i, z_i ~ N(0, 1) from `numpy.random.default_rng(5)`, sigma = {NOISE_SIGMA} of the bounding-box diagonal d.",
+        "05, 06, 07: denoising with sharp edges; compare with cad_part.obj",
+        True,
+    ),
+    Spec(
+        "cube.obj",
+        lambda: cube(),
+        "The cube [-0.5, 0.5]^3, 8 vertices, 12 triangles (two per face), outward.",
+        "05, 06: the handout's simple cube (smoothing shrinks it towards a sphere, then a point)",
+        True,
+    ),
 ]
 
 

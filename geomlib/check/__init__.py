@@ -6,11 +6,11 @@ One module per notebook holds its exercises' checks; ``result`` holds the
 vocabulary they are written in.
 """
 
-from .result import CheckFailed, CheckResult, Mistake, use  # noqa: F401
-from .uniform import *  # noqa: F401,F403
-from .forms import *  # noqa: F401,F403
 from .cotangent import *  # noqa: F401,F403
-from .spectral import *  # noqa: F401,F403
-from .explicit import *  # noqa: F401,F403
-from .implicit import *  # noqa: F401,F403
 from .denoising import *  # noqa: F401,F403
+from .explicit import *  # noqa: F401,F403
+from .forms import *  # noqa: F401,F403
+from .implicit import *  # noqa: F401,F403
+from .result import CheckFailed, CheckResult, Mistake, use  # noqa: F401
+from .spectral import *  # noqa: F401,F403
+from .uniform import *  # noqa: F401,F403

@@ -21,7 +21,7 @@ _REREAD_A = "section 2 · Which area? Barycentric and mixed Voronoi"
 
 _TET_V = np.array([[0.0, 0.0, 0.0], [1.3, 0.1, 0.0], [0.4, 1.1, 0.2], [0.3, 0.4, 0.9]])
 _TET_F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
-_OBTUSE_V = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [1.0, 1.0, 0.0]])   # obtuse at vertex 2, area 2
+_OBTUSE_V = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [1.0, 1.0, 0.0]])  # obtuse at vertex 2, area 2
 _OBTUSE_F = np.array([[0, 1, 2]])
 
 
@@ -56,8 +56,12 @@ def _weights(V, F, corner, of=lambda cot: cot):
 
 def _wrong_angle_variants(V, F):
     """Off-diagonals of C with the angle at i, at j, or at a face-order end of the edge, instead of opposite."""
-    return [_weights(V, F, lambda p, q, r: p), _weights(V, F, lambda p, q, r: q),
-            _weights(V, F, lambda p, q, r: (r + 1) % 3), _weights(V, F, lambda p, q, r: (r + 2) % 3)]
+    return [
+        _weights(V, F, lambda p, q, r: p),
+        _weights(V, F, lambda p, q, r: q),
+        _weights(V, F, lambda p, q, r: (r + 1) % 3),
+        _weights(V, F, lambda p, q, r: (r + 2) % 3),
+    ]
 
 
 @exercise("cotangent_laplacian", reread=_REREAD_C)
@@ -70,39 +74,55 @@ def cotangent_laplacian(fn):
         off = ~np.eye(len(V), dtype=bool)
         tan = _weights(V, F, lambda p, q, r: r, of=lambda cot: 1.0 / cot)
         if close(C, -C_ref):
-            raise Mistake("the sign of C is flipped",
-                          "C_ij = +(cot alpha_ij + cot beta_ij) / 2 off the diagonal, so that C is negative "
-                          "semidefinite and Delta x = -2 H n")
+            raise Mistake(
+                "the sign of C is flipped",
+                "C_ij = +(cot alpha_ij + cot beta_ij) / 2 off the diagonal, so that C is negative "
+                "semidefinite and Delta x = -2 H n",
+            )
         if close(C, 2 * C_ref) or close(C[off], 2 * C_ref[off]):
-            raise Mistake("the factor 1/2 is missing (every weight is twice the right one)",
-                          "C_ij = 1/2 (cot alpha_ij + cot beta_ij)")
+            raise Mistake(
+                "the factor 1/2 is missing (every weight is twice the right one)",
+                "C_ij = 1/2 (cot alpha_ij + cot beta_ij)",
+            )
         if close(C[off], C_ref[off]) and np.allclose(np.diag(C), 0):
-            raise Mistake("the diagonal of C is missing (its rows do not sum to zero)",
-                          "set C_ii = -sum of C_ij over the neighbours j of i")
+            raise Mistake(
+                "the diagonal of C is missing (its rows do not sum to zero)",
+                "set C_ii = -sum of C_ij over the neighbours j of i",
+            )
         if any(close(C[off], W[off]) for W in _wrong_angle_variants(V, F)):
-            raise Mistake("the cotangent of the wrong angle is used: an angle at i or j, an end of the edge ij",
-                          "use the two angles opposite the edge ij, at the third corner of each triangle")
+            raise Mistake(
+                "the cotangent of the wrong angle is used: an angle at i or j, an end of the edge ij",
+                "use the two angles opposite the edge ij, at the third corner of each triangle",
+            )
         if close(C[off], tan[off]) or close(C[off], -tan[off]):
             raise Mistake("tan is used instead of cot", "cot theta = cos theta / sin theta = 1 / tan theta")
         if not close(C, C.T):
             raise Mistake("C is not symmetric", "add each triangle's weight to both C_ij and C_ji")
         if not close(C, C_ref):
-            raise Mistake(f"C differs from the cotangent Laplacian on {label}",
-                          "each triangle (i, j, k) adds cot(angle at k) / 2 to C_ij and C_ji, and subtracts the "
-                          "same from C_ii and C_jj")
+            raise Mistake(
+                f"C differs from the cotangent Laplacian on {label}",
+                "each triangle (i, j, k) adds cot(angle at k) / 2 to C_ij and C_ji, and subtracts the "
+                "same from C_ii and C_jj",
+            )
         if close(M, np.eye(len(V))):
             raise Mistake("M is the identity", "M = diag(A_i), a third of the areas of the triangles around i")
         if close(M, 3 * M_ref):
-            raise Mistake("M is not divided by 3: each vertex gets the whole area of its triangles",
-                          "A_i = 1/3 of the sum of the incident triangle areas")
+            raise Mistake(
+                "M is not divided by 3: each vertex gets the whole area of its triangles",
+                "A_i = 1/3 of the sum of the incident triangle areas",
+            )
         if close(M, 2 * M_ref) or close(M, 6 * M_ref):
-            raise Mistake("M uses twice the triangle areas (the length of the cross product is 2 A)",
-                          "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2")
+            raise Mistake(
+                "M uses twice the triangle areas (the length of the cross product is 2 A)",
+                "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2",
+            )
         if np.count_nonzero(M[off]):
             raise Mistake("M is not diagonal", "M = diag(A_i): the lumped (diagonal) mass matrix")
         if not close(M, M_ref):
-            raise Mistake(f"M differs from the barycentric areas on {label}",
-                          "M_ii = 1/3 of the sum of the areas of the triangles around i")
+            raise Mistake(
+                f"M differs from the barycentric areas on {label}",
+                "M_ii = 1/3 of the sum of the areas of the triangles around i",
+            )
         checked.append(label)
     return checked
 
@@ -110,8 +130,10 @@ def cotangent_laplacian(fn):
 def _areas(fn, V, F, what):
     out = call(fn, V.copy(), F.copy())
     if np.ndim(out) == 1 and len(out) == len(F) != len(V):
-        raise Mistake(f"{what} returned one value per face ({len(F)}), not one per vertex ({len(V)})",
-                      "accumulate each face's share into its three vertices, e.g. with np.add.at or np.bincount")
+        raise Mistake(
+            f"{what} returned one value per face ({len(F)}), not one per vertex ({len(V)})",
+            "accumulate each face's share into its three vertices, e.g. with np.add.at or np.bincount",
+        )
     return vector(out, len(V), what)
 
 
@@ -123,18 +145,26 @@ def vertex_areas(fn):
         A = _areas(fn, V, F, "the function")
         ref = laplace.vertex_areas(V, F, "barycentric")
         if close(A, 3 * ref):
-            raise Mistake("the area is not divided by 3: each vertex gets the sum of its triangles' areas",
-                          "a triangle gives a third of its area to each of its corners")
+            raise Mistake(
+                "the area is not divided by 3: each vertex gets the sum of its triangles' areas",
+                "a triangle gives a third of its area to each of its corners",
+            )
         if close(A, 2 * ref) or close(A, 6 * ref):
-            raise Mistake("twice the triangle area is used (the length of the cross product is 2 A)",
-                          "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2")
+            raise Mistake(
+                "twice the triangle area is used (the length of the cross product is 2 A)",
+                "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2",
+            )
         if label == "one obtuse triangle" and close(A, laplace.vertex_areas(V, F, "mixed")):
-            raise Mistake("these are the mixed (Voronoi) areas, not the barycentric ones",
-                          "the barycentric area gives every corner the same third")
+            raise Mistake(
+                "these are the mixed (Voronoi) areas, not the barycentric ones",
+                "the barycentric area gives every corner the same third",
+            )
         if not close(A, ref):
-            raise Mistake(f"the areas differ from the barycentric areas on {label} "
-                          f"(sum {A.sum():.6g}, surface area {ref.sum():.6g})",
-                          "A_i = 1/3 of the sum of the areas of the triangles around i")
+            raise Mistake(
+                f"the areas differ from the barycentric areas on {label} "
+                f"(sum {A.sum():.6g}, surface area {ref.sum():.6g})",
+                "A_i = 1/3 of the sum of the areas of the triangles around i",
+            )
         checked.append(label)
     return checked
 
@@ -169,26 +199,37 @@ def mixed_areas(fn):
         swapped = np.where(obtuse_face, np.where(obtuse_corner, Af / 4, Af / 2), voronoi)
         only_at_obtuse = np.where(obtuse_corner, Af / 2, voronoi)
         if _is(A, _per_corner_sum(len(V), F, voronoi), ref):
-            raise Mistake("the obtuse rule is missing: these are the plain Voronoi areas, negative at corners "
-                          "of obtuse triangles",
-                          "in an obtuse triangle give A_f/2 to the obtuse corner and A_f/4 to the other two")
+            raise Mistake(
+                "the obtuse rule is missing: these are the plain Voronoi areas, negative at corners "
+                "of obtuse triangles",
+                "in an obtuse triangle give A_f/2 to the obtuse corner and A_f/4 to the other two",
+            )
         if _is(A, laplace.vertex_areas(V, F, "barycentric"), ref):
-            raise Mistake("these are the barycentric areas (a third of each triangle), not the mixed ones",
-                          "use the Voronoi piece 1/8 (|e_ij|^2 cot + |e_ik|^2 cot) in non-obtuse triangles")
+            raise Mistake(
+                "these are the barycentric areas (a third of each triangle), not the mixed ones",
+                "use the Voronoi piece 1/8 (|e_ij|^2 cot + |e_ik|^2 cot) in non-obtuse triangles",
+            )
         if _is(A, _per_corner_sum(len(V), F, swapped), ref):
-            raise Mistake("the halves are swapped in obtuse triangles: the obtuse corner gets A_f/4",
-                          "the obtuse corner gets A_f/2, the two acute corners A_f/4 each")
+            raise Mistake(
+                "the halves are swapped in obtuse triangles: the obtuse corner gets A_f/4",
+                "the obtuse corner gets A_f/2, the two acute corners A_f/4 each",
+            )
         if _is(A, _per_corner_sum(len(V), F, only_at_obtuse), ref):
-            raise Mistake("the obtuse rule is applied only at the obtuse corner; the other two corners of an "
-                          "obtuse triangle still get their Voronoi pieces",
-                          "in an obtuse triangle the two acute corners get A_f/4 each")
+            raise Mistake(
+                "the obtuse rule is applied only at the obtuse corner; the other two corners of an "
+                "obtuse triangle still get their Voronoi pieces",
+                "in an obtuse triangle the two acute corners get A_f/4 each",
+            )
         if close(A, 3 * ref) or close(A, 2 * ref):
-            raise Mistake("the areas are a whole multiple of the right ones",
-                          "check the factors: 1/8 in the Voronoi piece, A_f = |cross| / 2")
+            raise Mistake(
+                "the areas are a whole multiple of the right ones",
+                "check the factors: 1/8 in the Voronoi piece, A_f = |cross| / 2",
+            )
         if not close(A, ref):
-            raise Mistake(f"the areas differ from the mixed areas on {label} "
-                          f"(sum {A.sum():.6g}, surface area {ref.sum():.6g})",
-                          "non-obtuse triangle: 1/8 (|e_ij|^2 cot(angle at k) + |e_ik|^2 cot(angle at j)); "
-                          "obtuse: A_f/2 at the obtuse corner, A_f/4 at the others")
+            raise Mistake(
+                f"the areas differ from the mixed areas on {label} (sum {A.sum():.6g}, surface area {ref.sum():.6g})",
+                "non-obtuse triangle: 1/8 (|e_ij|^2 cot(angle at k) + |e_ik|^2 cot(angle at j)); "
+                "obtuse: A_f/2 at the obtuse corner, A_f/4 at the others",
+            )
         checked.append(label)
     return checked

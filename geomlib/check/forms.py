@@ -24,28 +24,38 @@ def _expressions(out):
     if isinstance(out, (tuple, list)) and len(out) == 2:
         I, II = (sp.Matrix(x) if not isinstance(x, sp.MatrixBase) else x for x in out)
         if I.shape != (2, 2) or II.shape != (2, 2):
-            raise Mistake(f"the forms have shapes {I.shape} and {II.shape}, expected two 2 x 2 matrices",
-                          "return (I, II) with I = Matrix([[E, F], [F, G]]) and II = Matrix([[e, f], [f, g]])")
+            raise Mistake(
+                f"the forms have shapes {I.shape} and {II.shape}, expected two 2 x 2 matrices",
+                "return (I, II) with I = Matrix([[E, F], [F, G]]) and II = Matrix([[e, f], [f, g]])",
+            )
         for name, A in (("I", I), ("II", II)):
             if sp.simplify(A[0, 1] - A[1, 0]) != 0:
-                raise Mistake(f"{name} is not symmetric", f"both off-diagonal entries of {name} are the same dot product")
+                raise Mistake(
+                    f"{name} is not symmetric", f"both off-diagonal entries of {name} are the same dot product"
+                )
         return [I[0, 0], I[0, 1], I[1, 1], II[0, 0], II[0, 1], II[1, 1]]
-    raise Mistake(f"the function returned {type(out).__name__}, not (E, F, G, e, f, g) or (I, II)",
-                  "end with `return E, F, G, e, f, g` (sympy expressions in a, b, c, u, v)")
+    raise Mistake(
+        f"the function returned {type(out).__name__}, not (E, F, G, e, f, g) or (I, II)",
+        "end with `return E, F, G, e, f, g` (sympy expressions in a, b, c, u, v)",
+    )
 
 
 def _values(exprs, symbols, points):
     """(6, len(points)) float array of the expressions at the points (a, b, c, u, v)."""
     extra = set().union(*(x.free_symbols for x in exprs)) - set(symbols)
     if extra:
-        raise Mistake(f"the expressions contain symbols other than a, b, c, u, v: {sorted(map(str, extra))}",
-                      "build p(u, v) from the symbols the function receives as arguments, not new ones")
+        raise Mistake(
+            f"the expressions contain symbols other than a, b, c, u, v: {sorted(map(str, extra))}",
+            "build p(u, v) from the symbols the function receives as arguments, not new ones",
+        )
     f = sp.lambdify(symbols, exprs, modules="numpy")
     with np.errstate(all="ignore"):
         vals = np.array([np.asarray(f(*pt), dtype=complex) for pt in points]).T
     if not np.all(np.isfinite(vals)) or np.abs(vals.imag).max() > 1e-9 * (1 + np.abs(vals.real).max()):
-        raise Mistake("the expressions are not real numbers at points inside the domain",
-                      "check square roots and divisions: 0 < v < pi, a, b, c > 0")
+        raise Mistake(
+            "the expressions are not real numbers at points inside the domain",
+            "check square roots and divisions: 0 < v < pi, a, b, c > 0",
+        )
     return vals.real
 
 
@@ -60,7 +70,7 @@ def _reference(points):
     p_vv = np.stack([-a * cu * sv, -b * su * sv, -c * cv], axis=1)
     m = np.cross(p_u, p_v)
     cross = np.linalg.norm(m, axis=1)
-    N = m / cross[:, None]                      # inward on this parameterisation: the workbook's II
+    N = m / cross[:, None]  # inward on this parameterisation: the workbook's II
     dot = lambda x, y: np.einsum("ij,ij->i", x, y)
     ref = np.array([dot(p_u, p_u), dot(p_u, p_v), dot(p_v, p_v), dot(p_uu, N), dot(p_uv, N), dot(p_vv, N)])
     return ref, cross
@@ -70,7 +80,9 @@ def _same(x, y):
     return np.allclose(x, y, rtol=1e-7, atol=1e-9)
 
 
-@exercise("fundamental_forms", reread="Steps 2 to 4 · the first fundamental form, the normal and the second fundamental form")
+@exercise(
+    "fundamental_forms", reread="Steps 2 to 4 · the first fundamental form, the normal and the second fundamental form"
+)
 def fundamental_forms(fn):
     """Check ``fn(a, b, c, u, v) -> (E, F, G, e, f, g)`` (or ``(I, II)``) for the ellipsoid, by value."""
     a, b, c = sp.symbols("a b c", positive=True)
@@ -83,40 +95,55 @@ def fundamental_forms(fn):
     # u as the polar angle and v as the longitude: the learner's E(u, v) is the true G(v, u)
     at_swapped = _values(exprs, (a, b, c, u, v), _POINTS[:, [0, 1, 2, 4, 3]])
     if not _same(first, ref[:3]) and (_same(at_swapped[:3], ref[:3]) or _same(at_swapped[[2, 1, 0]], ref[:3])):
-        raise Mistake("u and v are swapped: u is taken as the polar angle and v as the longitude",
-                      "p(u, v) = (a cos u sin v, b sin u sin v, c cos v): u turns around the z axis, "
-                      "v runs from the north pole (v = 0) to the south pole (v = pi)")
+        raise Mistake(
+            "u and v are swapped: u is taken as the polar angle and v as the longitude",
+            "p(u, v) = (a cos u sin v, b sin u sin v, c cos v): u turns around the z axis, "
+            "v runs from the north pole (v = 0) to the south pole (v = pi)",
+        )
     if not _same(first, ref[:3]):
         if _same(first, ref[:3][swap]):
-            raise Mistake("u and v are swapped: E and G are exchanged",
-                          "E = p_u . p_u with p_u = dp/du; u is the longitude, v the polar angle")
+            raise Mistake(
+                "u and v are swapped: E and G are exchanged",
+                "E = p_u . p_u with p_u = dp/du; u is the longitude, v the polar angle",
+            )
         if _same(first[[0, 2]], ref[[0, 2]]) and _same(first[1], -ref[1]):
             raise Mistake("F has the wrong sign", "F = p_u . p_v, the dot product of the two tangents as they are")
         wrong = [n for n, x, y in zip(_NAMES, first, ref[:3]) if not _same(x, y)]
-        raise Mistake(f"{', '.join(wrong)} of the first fundamental form differ from p_u . p_u, p_u . p_v, p_v . p_v",
-                      "differentiate p(u, v) = (a cos u sin v, b sin u sin v, c cos v) once in u and once in v")
+        raise Mistake(
+            f"{', '.join(wrong)} of the first fundamental form differ from p_u . p_u, p_u . p_v, p_v . p_v",
+            "differentiate p(u, v) = (a cos u sin v, b sin u sin v, c cos v) once in u and once in v",
+        )
     if _same(second, ref[3:]):
         return ["E, F, G, e, f, g at three generic points (F != 0) of three ellipsoids"]
     if _same(second, ref[3:][swap]):
-        raise Mistake("u and v are swapped in the second fundamental form: e and g are exchanged",
-                      "e = p_uu . N, g = p_vv . N")
+        raise Mistake(
+            "u and v are swapped in the second fundamental form: e and g are exchanged", "e = p_uu . N, g = p_vv . N"
+        )
     if _same(second, -ref[3:]):
-        raise Mistake("the sign of the normal is flipped: e, f, g are all negated",
-                      "the workbook's II uses the inward normal N = p_u x p_v / |p_u x p_v| on this ellipsoid, "
-                      "so that every curvature of a convex surface is positive")
+        raise Mistake(
+            "the sign of the normal is flipped: e, f, g are all negated",
+            "the workbook's II uses the inward normal N = p_u x p_v / |p_u x p_v| on this ellipsoid, "
+            "so that every curvature of a convex surface is positive",
+        )
     for sign in (1, -1):
         if _same(second, sign * cross * ref[3:]):
-            raise Mistake("the normal is not normalised: e, f, g are multiplied by |p_u x p_v| = sin v W",
-                          "divide p_u x p_v by its length before dotting it with p_uu, p_uv, p_vv")
+            raise Mistake(
+                "the normal is not normalised: e, f, g are multiplied by |p_u x p_v| = sin v W",
+                "divide p_u x p_v by its length before dotting it with p_uu, p_uv, p_vv",
+            )
     with np.errstate(all="ignore"):
         ratio = second / ref[3:]
     usable = np.isfinite(ratio) & (np.abs(ref[3:]) > 1e-9)
     if usable.any() and np.allclose(ratio[usable], ratio[usable][0]) and not np.isclose(abs(ratio[usable][0]), 1):
-        raise Mistake(f"e, f, g are all off by the same factor {ratio[usable][0]:.4g}: the normal is not a unit vector",
-                      "N = p_u x p_v / |p_u x p_v|")
+        raise Mistake(
+            f"e, f, g are all off by the same factor {ratio[usable][0]:.4g}: the normal is not a unit vector",
+            "N = p_u x p_v / |p_u x p_v|",
+        )
     wrong = [n for n, x, y in zip(_NAMES[3:], second, ref[3:]) if not _same(x, y)]
-    raise Mistake(f"{', '.join(wrong)} of the second fundamental form differ from p_uu . N, p_uv . N, p_vv . N",
-                  "take the second derivatives of p and dot them with the unit normal N = p_u x p_v / |p_u x p_v|")
+    raise Mistake(
+        f"{', '.join(wrong)} of the second fundamental form differ from p_uu . N, p_uv . N, p_vv . N",
+        "take the second derivatives of p and dot them with the unit normal N = p_u x p_v / |p_u x p_v|",
+    )
 
 
 # (a, b, c) triples with b != c (at b = c every direction at (a, 0, 0) is principal) and angles phi
@@ -134,35 +161,57 @@ def normal_curvature(fn):
             try:
                 got[i, j] = float(out)
             except (TypeError, ValueError):
-                raise Mistake(f"the function returned {type(out).__name__} ({out!s:.60}), not a number",
-                              "return kappa_n as one number for the given a, b, c, phi (substitute them "
-                              "into a sympy expression, or write it with numpy)") from None
+                raise Mistake(
+                    f"the function returned {type(out).__name__} ({out!s:.60}), not a number",
+                    "return kappa_n as one number for the given a, b, c, phi (substitute them "
+                    "into a sympy expression, or write it with numpy)",
+                ) from None
     a, b, c = (_AXES[:, k, None] for k in range(3))
     cos2, sin2 = np.cos(_PHIS) ** 2, np.sin(_PHIS) ** 2
     right = a * cos2 / b**2 + a * sin2 / c**2
     if _same(got, right):
         return ["(a, 0, 0) of three ellipsoids, six directions each"]
     diagnoses = [
-        (-right, "the sign is flipped",
-         "at (a, 0, 0) the ellipsoid bends away from its outward normal: kappa_n > 0, as on a sphere"),
-        (a * sin2 / b**2 + a * cos2 / c**2,
-         "kappa_n(0) came out a / c^2: b and c are exchanged, or phi is measured from p_v instead of p_u",
-         "phi = 0 is the direction of p_u = (0, b, 0), of length b, so kappa_n(0) = e / E = a / b^2"),
-        (np.broadcast_to(a, right.shape), "kappa_n = a for every phi: II(t, t) is not divided by the first form",
-         "kappa_n = II(t, t) / I(t, t); with (du, dv) = (cos phi, sin phi), I(t, t) = b^2 cos^2 phi + c^2 sin^2 phi"),
-        (np.broadcast_to(a / b**2, right.shape), "kappa_n = a / b^2 for every phi: only E divides, for both directions",
-         "divide II(t, t) by I(t, t), which mixes E and G as the direction turns"),
-        (a / (b**2 * cos2 + c**2 * sin2),
-         "phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi) treats p_u, p_v as unit vectors",
-         "the unit tangent at angle phi has (du, dv) = (cos phi / b, sin phi / c), since |p_u| = b and |p_v| = c"),
-        (a * cos2 / b**4 + a * sin2 / c**4, "the first form divides twice",
-         "with (du, dv) = (cos phi / b, sin phi / c) the tangent is already a unit vector: I(t, t) = 1"),
+        (
+            -right,
+            "the sign is flipped",
+            "at (a, 0, 0) the ellipsoid bends away from its outward normal: kappa_n > 0, as on a sphere",
+        ),
+        (
+            a * sin2 / b**2 + a * cos2 / c**2,
+            "kappa_n(0) came out a / c^2: b and c are exchanged, or phi is measured from p_v instead of p_u",
+            "phi = 0 is the direction of p_u = (0, b, 0), of length b, so kappa_n(0) = e / E = a / b^2",
+        ),
+        (
+            np.broadcast_to(a, right.shape),
+            "kappa_n = a for every phi: II(t, t) is not divided by the first form",
+            "kappa_n = II(t, t) / I(t, t); with (du, dv) = (cos phi, sin phi), I(t, t) = b^2 cos^2 phi + c^2 sin^2 phi",
+        ),
+        (
+            np.broadcast_to(a / b**2, right.shape),
+            "kappa_n = a / b^2 for every phi: only E divides, for both directions",
+            "divide II(t, t) by I(t, t), which mixes E and G as the direction turns",
+        ),
+        (
+            a / (b**2 * cos2 + c**2 * sin2),
+            "phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi) treats p_u, p_v as unit vectors",
+            "the unit tangent at angle phi has (du, dv) = (cos phi / b, sin phi / c), since |p_u| = b and |p_v| = c",
+        ),
+        (
+            a * cos2 / b**4 + a * sin2 / c**4,
+            "the first form divides twice",
+            "with (du, dv) = (cos phi / b, sin phi / c) the tangent is already a unit vector: I(t, t) = 1",
+        ),
     ]
     for wrong, diagnosis, hint in diagnoses:
         if _same(got, wrong):
             raise Mistake(diagnosis, hint)
     if np.allclose(got[:, 0], right[:, 0]) and np.allclose(got[:, 3], right[:, 3]):
-        raise Mistake("kappa_n is right along p_u and p_v but not between them",
-                      "Euler: kappa_n = kappa_u cos^2 phi + kappa_v sin^2 phi, squares of cos and sin")
-    raise Mistake("kappa_n differs from II(t, t) / I(t, t) at (a, 0, 0)",
-                  "at (a, 0, 0): I = diag(b^2, c^2), II = diag(a, a), (du, dv) = (cos phi / b, sin phi / c)")
+        raise Mistake(
+            "kappa_n is right along p_u and p_v but not between them",
+            "Euler: kappa_n = kappa_u cos^2 phi + kappa_v sin^2 phi, squares of cos and sin",
+        )
+    raise Mistake(
+        "kappa_n differs from II(t, t) / I(t, t) at (a, 0, 0)",
+        "at (a, 0, 0): I = diag(b^2, c^2), II = diag(a, a), (du, dv) = (cos phi / b, sin phi / c)",
+    )

@@ -9,7 +9,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..laplace import laplacian
-from .explicit import step_cases, positions
+from .explicit import positions, step_cases
 from .result import Mistake, call, close, exercise
 
 __all__ = ["implicit_step"]
@@ -37,22 +37,34 @@ def implicit_step(fn):
             if close(out, right, rtol=1e-7):
                 continue
             if close(out, P + tau * (C @ P) / M.diagonal()[:, None], rtol=1e-7):
-                raise Mistake("this is one explicit step P + tau M^-1 C P, not an implicit one",
-                              "evaluate the Laplacian at the new positions: solve (M - tau C) P' = M P")
+                raise Mistake(
+                    "this is one explicit step P + tau M^-1 C P, not an implicit one",
+                    "evaluate the Laplacian at the new positions: solve (M - tau C) P' = M P",
+                )
             if close(out, _solve(M + tau * C, M @ P), rtol=1e-7):
-                raise Mistake("the sign in the matrix is flipped: (M + tau C) instead of (M - tau C)",
-                              "C is negative semidefinite; M - tau C is the positive definite one")
+                raise Mistake(
+                    "the sign in the matrix is flipped: (M + tau C) instead of (M - tau C)",
+                    "C is negative semidefinite; M - tau C is the positive definite one",
+                )
             if close(out, _solve(M - tau * C, P), rtol=1e-7):
-                raise Mistake("the right-hand side is P instead of M P",
-                              "multiplying (P' - P) / tau = M^-1 C P' by tau M gives M P on the right")
+                raise Mistake(
+                    "the right-hand side is P instead of M P",
+                    "multiplying (P' - P) / tau = M^-1 C P' by tau M gives M P on the right",
+                )
             if close(out, _solve(I - tau * C, P), rtol=1e-7) or close(out, _solve(I - tau * C, M @ P), rtol=1e-7):
-                raise Mistake("the matrix is (I - tau C): M is missing",
-                              "the system is (M - tau C) P' = M P (or I - tau M^-1 C with P on the right)")
+                raise Mistake(
+                    "the matrix is (I - tau C): M is missing",
+                    "the system is (M - tau C) P' = M P (or I - tau M^-1 C with P on the right)",
+                )
             if close(out, right - P, rtol=1e-7):
-                raise Mistake("the function returns the displacement P' - P, not the new positions",
-                              "return the solution P' of the system itself")
-            raise Mistake(f"the new positions differ from the solution of (M - tau C) P' = M P on {label} "
-                          f"(largest difference {np.abs(out - right).max():.3g})",
-                          "scipy.sparse.linalg.spsolve((M - tau * C).tocsc(), M @ P)")
+                raise Mistake(
+                    "the function returns the displacement P' - P, not the new positions",
+                    "return the solution P' of the system itself",
+                )
+            raise Mistake(
+                f"the new positions differ from the solution of (M - tau C) P' = M P on {label} "
+                f"(largest difference {np.abs(out - right).max():.3g})",
+                "scipy.sparse.linalg.spsolve((M - tau * C).tocsc(), M @ P)",
+            )
         checked.append(label)
     return checked

@@ -36,8 +36,7 @@ import scipy.sparse as sp
 
 from ..notebook import strict_claims
 
-__all__ = ["CheckResult", "CheckFailed", "Mistake", "exercise", "call", "matrix_pair", "vector",
-           "close", "use"]
+__all__ = ["CheckResult", "CheckFailed", "Mistake", "exercise", "call", "matrix_pair", "vector", "close", "use"]
 
 
 class CheckFailed(AssertionError):
@@ -78,9 +77,11 @@ class CheckResult:
 
     def _repr_html_(self):
         colour, mark = ("#1a7f37", "✔ passed") if self.passed else ("#b35900", "✘ not yet")
-        return (f'<div class="geomlib-check" style="border-left:4px solid {colour};padding:0.3em 0.8em">'
-                f'<b>{html.escape(self.name)}</b>: <b style="color:{colour}">{mark}</b>. '
-                f'{html.escape(self.message)}</div>')
+        return (
+            f'<div class="geomlib-check" style="border-left:4px solid {colour};padding:0.3em 0.8em">'
+            f'<b>{html.escape(self.name)}</b>: <b style="color:{colour}">{mark}</b>. '
+            f"{html.escape(self.message)}</div>"
+        )
 
 
 def call(fn, *args):
@@ -92,8 +93,10 @@ def call(fn, *args):
     except Mistake:
         raise
     except Exception as exc:  # the learner's code may raise anything; name it
-        raise Mistake(f"the function raised {type(exc).__name__}: {exc}",
-                      "run it on the small example in the cell above and read the traceback") from None
+        raise Mistake(
+            f"the function raised {type(exc).__name__}: {exc}",
+            "run it on the small example in the cell above and read the traceback",
+        ) from None
 
 
 def _dense(A):
@@ -103,15 +106,19 @@ def _dense(A):
 def matrix_pair(out, n):
     """Check that ``out`` is a pair (M, C) of n x n matrices; return them dense as float arrays."""
     if not isinstance(out, tuple) or len(out) != 2:
-        raise Mistake(f"the function returned {type(out).__name__}, not the pair (M, C)",
-                      "end with `return M, C`, M the diagonal mass matrix and C the weight matrix")
+        raise Mistake(
+            f"the function returned {type(out).__name__}, not the pair (M, C)",
+            "end with `return M, C`, M the diagonal mass matrix and C the weight matrix",
+        )
     M, C = (_dense(A) for A in out)
     for name, A in (("M", M), ("C", C)):
         if A.shape == (n,) and name == "M":
             raise Mistake("M is a vector, not a matrix", "return the diagonal matrix scipy.sparse.diags(areas)")
         if A.shape != (n, n):
-            raise Mistake(f"{name} has shape {A.shape}, expected ({n}, {n}) for a mesh with {n} vertices",
-                          "one row and one column per vertex")
+            raise Mistake(
+                f"{name} has shape {A.shape}, expected ({n}, {n}) for a mesh with {n} vertices",
+                "one row and one column per vertex",
+            )
     return M.astype(float), C.astype(float)
 
 
@@ -119,8 +126,10 @@ def vector(out, n, what="the function"):
     """Check that ``out`` is a length-n vector of numbers; return it as a float array."""
     x = np.asarray(out, dtype=float) if not sp.issparse(out) else _dense(out).astype(float)
     if x.shape not in ((n,), (n, 1), (1, n)):
-        raise Mistake(f"{what} returned shape {x.shape}, expected ({n},): one value per vertex",
-                      "return a flat numpy array with one entry per vertex")
+        raise Mistake(
+            f"{what} returned shape {x.shape}, expected ({n},): one value per vertex",
+            "return a flat numpy array with one entry per vertex",
+        )
     return x.reshape(n)
 
 
@@ -140,8 +149,12 @@ def exercise(name, reread):
                 checked = body(fn)
             except _NotWritten as exc:
                 detail = f" ({exc})" if str(exc) else ""
-                return CheckResult(name, False, f"not written yet: the function raises NotImplementedError{detail}. "
-                                                f"Reread {reread} and fill it in.")
+                return CheckResult(
+                    name,
+                    False,
+                    f"not written yet: the function raises NotImplementedError{detail}. "
+                    f"Reread {reread} and fill it in.",
+                )
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
                 if strict_claims():
@@ -164,6 +177,8 @@ def use(fn, check, reference):
     if result.passed:
         print(f"Using your {fn.__name__} (its check passed).")
         return fn
-    print(f"Your {getattr(fn, '__name__', 'function')} has not passed its check yet; "
-          f"the cells below use geomlib's {reference.__module__}.{reference.__name__}.")
+    print(
+        f"Your {getattr(fn, '__name__', 'function')} has not passed its check yet; "
+        f"the cells below use geomlib's {reference.__module__}.{reference.__name__}."
+    )
     return reference

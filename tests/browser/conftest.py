@@ -31,12 +31,17 @@ def _on_ci():
 
 
 def _unavailable(reason):
-    message = (f"browser tests skipped: {reason}. To run them install Chromium "
-               "(`apt-get install chromium` on Debian/Ubuntu; the binary must be /usr/bin/chromium, "
-               "or set GEOMLIB_CHROMIUM to another Chromium binary).")
+    message = (
+        f"browser tests skipped: {reason}. To run them install Chromium "
+        "(`apt-get install chromium` on Debian/Ubuntu; the binary must be /usr/bin/chromium, "
+        "or set GEOMLIB_CHROMIUM to another Chromium binary)."
+    )
     if _on_ci():
-        pytest.fail(f"CI is set but the browser tests cannot run: {reason}. "
-                    "Install Chromium (`apt-get install -y chromium`; .ci/run does this).", pytrace=False)
+        pytest.fail(
+            f"CI is set but the browser tests cannot run: {reason}. "
+            "Install Chromium (`apt-get install -y chromium`; .ci/run does this).",
+            pytrace=False,
+        )
     pytest.skip(message)
 
 

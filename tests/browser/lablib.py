@@ -30,18 +30,23 @@ from pathlib import Path
 
 CHROMIUM = os.environ.get("GEOMLIB_CHROMIUM", "/usr/bin/chromium")
 CHROMIUM_ARGS = [
-    "--headless=new", "--no-sandbox", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-    "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    "--headless=new",
+    "--no-sandbox",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--use-gl=angle",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
 ]
 VIEWPORT = {"width": 1400, "height": 1000}
 
 # user settings written for the test server (JupyterLab settings JSON)
 LAB_SETTINGS = {
-    "@jupyterlab/apputils-extension/notification.jupyterlab-settings":
-        {"fetchNews": "false", "checkForUpdates": False},
-    "@jupyterlab/notebook-extension/tracker.jupyterlab-settings":
-        {"windowingMode": "none"},
+    "@jupyterlab/apputils-extension/notification.jupyterlab-settings": {"fetchNews": "false", "checkForUpdates": False},
+    "@jupyterlab/notebook-extension/tracker.jupyterlab-settings": {"windowingMode": "none"},
 }
 
 
@@ -67,8 +72,7 @@ class LabServer:
     workbook.py writes into .venv); ``args`` go to the app.
     """
 
-    def __init__(self, notebook_dir, startup_timeout=90, app="lab", user_settings=None, overrides=None,
-                 args=()):
+    def __init__(self, notebook_dir, startup_timeout=90, app="lab", user_settings=None, overrides=None, args=()):
         self.app = app
         self.user_settings = LAB_SETTINGS if user_settings is None else user_settings
         self.overrides = overrides
@@ -84,16 +88,19 @@ class LabServer:
         self.log_path = self.tmp / "server.log"
 
     def start(self):
-        shutil.copytree(self.source, self.root,
-                        ignore=shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__"))
+        shutil.copytree(self.source, self.root, ignore=shutil.ignore_patterns(".ipynb_checkpoints", "__pycache__"))
         settings = self.tmp / "user-settings"
         for rel, value in self.user_settings.items():
             path = settings / rel
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_text(json.dumps(value))
         env = dict(os.environ)
-        for key, sub in (("JUPYTER_CONFIG_DIR", "config"), ("JUPYTER_DATA_DIR", "data"),
-                         ("JUPYTER_RUNTIME_DIR", "runtime"), ("IPYTHONDIR", "ipython")):
+        for key, sub in (
+            ("JUPYTER_CONFIG_DIR", "config"),
+            ("JUPYTER_DATA_DIR", "data"),
+            ("JUPYTER_RUNTIME_DIR", "runtime"),
+            ("IPYTHONDIR", "ipython"),
+        ):
             (self.tmp / sub).mkdir()
             env[key] = str(self.tmp / sub)
         env.pop("JUPYTER_PATH", None)
@@ -104,8 +111,12 @@ class LabServer:
             (self.tmp / "app-settings" / "overrides.json").write_text(json.dumps(self.overrides))
             self.args.append(f"--{app_class}.app_settings_dir={self.tmp / 'app-settings'}")
         cmd = [
-            sys.executable, "-m", module, "--no-browser",
-            "--ServerApp.ip=127.0.0.1", f"--ServerApp.port={self.port}",
+            sys.executable,
+            "-m",
+            module,
+            "--no-browser",
+            "--ServerApp.ip=127.0.0.1",
+            f"--ServerApp.port={self.port}",
             "--ServerApp.port_retries=0",
             f"--IdentityProvider.token={self.token}",
             f"--ServerApp.root_dir={self.root}",
@@ -116,10 +127,11 @@ class LabServer:
             *self.args,
         ]
         if hasattr(os, "geteuid") and os.geteuid() == 0:
-            cmd.append("--allow-root")   # containers and CI machines often run as root
+            cmd.append("--allow-root")  # containers and CI machines often run as root
         self._log = open(self.log_path, "wb")
-        self.proc = subprocess.Popen(cmd, cwd=self.root, env=env, stdout=self._log,
-                                     stderr=subprocess.STDOUT, start_new_session=True)
+        self.proc = subprocess.Popen(
+            cmd, cwd=self.root, env=env, stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True
+        )
         deadline = time.monotonic() + self.startup_timeout
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
@@ -280,7 +292,7 @@ def run_all(page, timeout_s=180):
         finished = state["done"] == state["code"] and state["pending"] == 0 and state["kernel"] == "idle"
         if finished or (state["errors"] and state["pending"] == 0 and state["kernel"] == "idle"):
             idle_since = idle_since or time.monotonic()
-            if time.monotonic() - idle_since > 1.0:    # stay idle for a moment: widgets render
+            if time.monotonic() - idle_since > 1.0:  # stay idle for a moment: widgets render
                 return state
         else:
             idle_since = None

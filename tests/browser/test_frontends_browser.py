@@ -18,16 +18,15 @@ import importlib.util
 import time
 from pathlib import Path
 
-import pytest
-
 import lablib
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOK_DIR = ROOT / "notebooks"
-RUN_TIMEOUT = 180          # seconds for one notebook to run top to bottom
-RENDER_TIMEOUT = 30        # seconds for a view to draw / react to a slider
-WATCH = 25                 # seconds a newcomer's page is watched for pop-ups (JupyterLab asks
-                           # about news some 10-15 s after start-up when nothing answered it)
+RUN_TIMEOUT = 180  # seconds for one notebook to run top to bottom
+RENDER_TIMEOUT = 30  # seconds for a view to draw / react to a slider
+WATCH = 25  # seconds a newcomer's page is watched for pop-ups (JupyterLab asks
+# about news some 10-15 s after start-up when nothing answered it)
 
 pytestmark = pytest.mark.browser
 
@@ -52,8 +51,7 @@ def notebook7_server(browser):
     overrides = dict(WORKBOOK.LAB_OVERRIDES)
     # every cell attached to the page, so views below the fold render too
     overrides["@jupyterlab/notebook-extension:tracker"] = {"windowingMode": "none"}
-    server = lablib.LabServer(NOTEBOOK_DIR, app="notebook", overrides=overrides,
-                              args=_default_url_args("notebook"))
+    server = lablib.LabServer(NOTEBOOK_DIR, app="notebook", overrides=overrides, args=_default_url_args("notebook"))
     server.start()
     try:
         yield server
@@ -63,8 +61,9 @@ def notebook7_server(browser):
 
 @pytest.fixture(scope="module")
 def newcomer_lab_server(browser):
-    server = lablib.LabServer(NOTEBOOK_DIR, app="lab", user_settings={}, overrides=WORKBOOK.LAB_OVERRIDES,
-                              args=_default_url_args("lab"))
+    server = lablib.LabServer(
+        NOTEBOOK_DIR, app="lab", user_settings={}, overrides=WORKBOOK.LAB_OVERRIDES, args=_default_url_args("lab")
+    )
     server.start()
     try:
         yield server
@@ -143,7 +142,9 @@ def test_notebook_in_notebook7(notebook, browser, notebook7_server):
         state = lablib.run_all(page, timeout_s=RUN_TIMEOUT)
         page.screenshot(path=str(screenshot_dir / "page.png"))
         assert not state.get("timeout"), f"{notebook}: {state['done']} of {state['code']} code cells ran in time"
-        assert not state["errors"], f"{notebook} has error outputs: {[(e['cell'], e['ename'], e['evalue']) for e in state['errors']]}"
+        assert not state["errors"], (
+            f"{notebook} has error outputs: {[(e['cell'], e['ename'], e['evalue']) for e in state['errors']]}"
+        )
         assert state["done"] == state["code"]
 
         canvases = page.locator(".geomlib-canvas")

@@ -18,16 +18,15 @@ import os
 import time
 from pathlib import Path
 
-import pytest
-
 import lablib
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 # GEOMLIB_NOTEBOOK_DIR runs the same checks on another folder of notebooks
 NOTEBOOK_DIR = Path(os.environ.get("GEOMLIB_NOTEBOOK_DIR", ROOT / "notebooks"))
 NOTEBOOKS = sorted(p.name for p in NOTEBOOK_DIR.glob("*.ipynb"))
-RUN_TIMEOUT = 180          # seconds for one notebook to run top to bottom
-RENDER_TIMEOUT = 30        # seconds for a view to show a picture / react to a slider
+RUN_TIMEOUT = 180  # seconds for one notebook to run top to bottom
+RENDER_TIMEOUT = 30  # seconds for a view to show a picture / react to a slider
 
 pytestmark = pytest.mark.browser
 
@@ -63,7 +62,8 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
 
         # 1-2: ran to the end without error outputs
         assert not state.get("timeout"), (
-            f"{notebook} did not finish within {RUN_TIMEOUT} s: {state['done']} of {state['code']} code cells ran")
+            f"{notebook} did not finish within {RUN_TIMEOUT} s: {state['done']} of {state['code']} code cells ran"
+        )
         assert not state["errors"], f"{notebook} has error outputs:\n{_format_errors(state['errors'])}"
         assert state["done"] == state["code"], f"only {state['done']} of {state['code']} code cells ran"
 
@@ -82,14 +82,17 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             ok = _wait_for(rendered, RENDER_TIMEOUT)
             (screenshot_dir / f"canvas{i}.png").write_bytes(shot["png"])
             _, distinct, covered = _not_blank(shot["png"])
-            assert ok, (f"view {i} of {notebook} looks blank: {distinct} colours, "
-                        f"{covered:.1%} of the pixels off the background")
+            assert ok, (
+                f"view {i} of {notebook} looks blank: {distinct} colours, "
+                f"{covered:.1%} of the pixels off the background"
+            )
 
         # 4: a slider beside a view changes the picture
         found = page.evaluate(lablib.JS_FIND_SLIDER)
         assert found["found"], (
             f"{notebook}: no slider shares an ipywidgets box or a cell with a view; put them in one box, "
-            "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/viewer.py)")
+            "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/viewer.py)"
+        )
         box_canvases = page.locator("[data-geomlib-box] .geomlib-canvas")
         before = [lablib.stable_screenshot(box_canvases.nth(i)) for i in range(box_canvases.count())]
         handle = page.locator("[data-geomlib-slider] .noUi-handle").first
@@ -108,8 +111,10 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         for i, png in enumerate(moved["after"]):
             (screenshot_dir / f"slider_after{i}.png").write_bytes(png)
         page.screenshot(path=str(screenshot_dir / "page_after_slider.png"))
-        assert ok, (f"{notebook}: moving the slider '{found['description']}' changed "
-                    f"{moved['fraction']:.2%} of the view's pixels")
+        assert ok, (
+            f"{notebook}: moving the slider '{found['description']}' changed "
+            f"{moved['fraction']:.2%} of the view's pixels"
+        )
         state = page.evaluate(lablib.JS_STATE)
         assert not state["errors"], f"the slider callback raised:\n{_format_errors(state['errors'])}"
 
@@ -123,7 +128,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 continue
             first, second = views.nth(0), views.nth(1)
             turned = followed = False
-            for attempt in range(3):          # a drag can miss while the page is still laying out
+            for attempt in range(3):  # a drag can miss while the page is still laying out
                 before_first = lablib.stable_screenshot(first)
                 before_second = lablib.stable_screenshot(second)
                 box = first.bounding_box()
@@ -133,17 +138,21 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 page.mouse.move(x + 90, y + 40, steps=10)
                 page.mouse.up()
                 turned = _wait_for(
-                    lambda: lablib.changed_fraction(before_first, lablib.stable_screenshot(first)) > 0.005, 10)
+                    lambda: lablib.changed_fraction(before_first, lablib.stable_screenshot(first)) > 0.005, 10
+                )
                 if not turned:
                     continue
                 followed = _wait_for(
                     lambda: lablib.changed_fraction(before_second, lablib.stable_screenshot(second)) > 0.005,
-                    RENDER_TIMEOUT)
+                    RENDER_TIMEOUT,
+                )
                 break
             (screenshot_dir / f"row{r}_linked.png").write_bytes(second.screenshot())
             assert turned, f"{notebook}: an orbit drag did not turn the first view of side_by_side row {r}"
-            assert followed, (f"{notebook}: orbiting the first view of side_by_side row {r} "
-                              "did not turn the second (cameras not linked)")
+            assert followed, (
+                f"{notebook}: orbiting the first view of side_by_side row {r} "
+                "did not turn the second (cameras not linked)"
+            )
     finally:
         (screenshot_dir / "console.txt").write_text("\n".join(console))
         lablib.shutdown_kernel(page)

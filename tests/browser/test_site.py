@@ -34,10 +34,9 @@ import threading
 import time
 from pathlib import Path
 
+import lablib
 import nbformat
 import pytest
-
-import lablib
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
@@ -46,7 +45,7 @@ import build_site  # noqa: E402
 
 NOTEBOOKS = sorted(p.name for p in build_site.NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
 SCREENSHOTS = ROOT / "build" / "screenshots" / "site"
-LOAD_TIMEOUT = 90          # seconds for a page's views and formulas to appear
+LOAD_TIMEOUT = 90  # seconds for a page's views and formulas to appear
 LOCAL_SCHEMES = ("file:", "data:", "blob:")
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
@@ -168,12 +167,13 @@ def _shot_if(canvas, accept):
 def _check_canvases(page, expected, shots):
     """Every canvas drawn and turned by a drag; returns the number of canvases."""
     canvases = page.locator("canvas")
-    assert _wait_for(lambda: canvases.count() >= expected, LOAD_TIMEOUT), \
+    assert _wait_for(lambda: canvases.count() >= expected, LOAD_TIMEOUT), (
         f"{canvases.count()} canvases appeared; the build saved {expected} live views"
+    )
     for i in range(canvases.count()):
         canvas = canvases.nth(i)
         canvas.scroll_into_view_if_needed()
-        canvas.hover()     # a view frozen to a picture comes back to life when the mouse enters
+        canvas.hover()  # a view frozen to a picture comes back to life when the mouse enters
         before = _wait_for(lambda canvas=canvas: _shot_if(canvas, _not_blank), 30)
         assert before, f"canvas {i} stays blank"
         (shots / f"canvas{i}.png").write_bytes(before)
@@ -183,8 +183,12 @@ def _check_canvases(page, expected, shots):
         page.mouse.down()
         page.mouse.move(x + 90, y + 25, steps=12)
         page.mouse.up()
-        after = _wait_for(lambda canvas=canvas, before=before: _shot_if(
-            canvas, lambda png: lablib.changed_fraction(before, png) > 0.01), 20)
+        after = _wait_for(
+            lambda canvas=canvas, before=before: _shot_if(
+                canvas, lambda png: lablib.changed_fraction(before, png) > 0.01
+            ),
+            20,
+        )
         assert after, f"an orbit drag on canvas {i} does not change its picture"
         (shots / f"canvas{i}-dragged.png").write_bytes(after)
     return canvases.count()
@@ -203,12 +207,12 @@ def test_page_offline(notebook, site, site_url, browser):
         page.goto(site_url + name, wait_until="load")
         assert page.evaluate(JS_MATH_DONE), "MathJax did not load"
         math = page.evaluate(JS_MATH)
-        markdown = "\n".join(c.source for c in nbformat.read(build_site.NOTEBOOKS / notebook, 4).cells
-                             if c.cell_type == "markdown")
+        markdown = "\n".join(
+            c.source for c in nbformat.read(build_site.NOTEBOOKS / notebook, 4).cells if c.cell_type == "markdown"
+        )
         if re.search(r"\$[^$\s][^$]*\$", markdown):
             assert math["formulas"] > 0, "the notebook has formulas but MathJax found none"
-        assert math["typeset"] >= math["formulas"], \
-            f"MathJax typeset {math['typeset']} of {math['formulas']} formulas"
+        assert math["typeset"] >= math["formulas"], f"MathJax typeset {math['typeset']} of {math['formulas']} formulas"
         assert math["errors"] == 0, f"{math['errors']} formulas show a TeX error"
         assert math["raw"] == 0, f"{math['raw']} '$$' left untypeset in the text"
 
@@ -224,7 +228,9 @@ def test_page_offline(notebook, site, site_url, browser):
         assert not view.errors, "console errors:\n" + "\n".join(view.errors)
     finally:
         view.close()
-    assert not pages[name]["errors"], "cells raised errors while the site was built:\n" + "\n".join(pages[name]["errors"])
+    assert not pages[name]["errors"], "cells raised errors while the site was built:\n" + "\n".join(
+        pages[name]["errors"]
+    )
 
 
 def test_index_lists_pages_in_order(site, site_url, browser):
@@ -235,7 +241,7 @@ def test_index_lists_pages_in_order(site, site_url, browser):
         links = view.page.eval_on_selector_all("ol a", "els => els.map(a => a.getAttribute('href'))")
         assert links == [Path(n).stem + ".html" for n in NOTEBOOKS]
         items = view.page.eval_on_selector_all("ol li", "els => els.map(e => e.innerText)")
-        for name, item in zip(links, items):   # relative links to files that exist
+        for name, item in zip(links, items):  # relative links to files that exist
             assert "/" not in name and (folder / name).is_file()
             assert f"({pages[name]['views']} live 3D view" in item, item
         view.page.goto(site_url + links[0])
@@ -286,8 +292,9 @@ def test_stills_show_without_webgl(site, site_url, browser):
         view.page.goto(site_url + name, wait_until="load")
         stills = view.page.locator("img.site-still")
         assert stills.count() > 0, "the page holds no still pictures of its views"
-        assert _wait_for(lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30), \
+        assert _wait_for(lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30), (
             f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
+        )
         for i in range(stills.count()):
             assert _not_blank(lablib.stable_screenshot(stills.nth(i))), f"still {i} is blank"
         assert not view.outside, f"requests to the network: {view.outside}"
