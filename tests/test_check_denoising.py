@@ -26,30 +26,55 @@ def noise_reference(V, F, sigma, seed):
 
 # typical wrong noise models, each with a phrase its diagnosis must contain
 WRONG_NOISE = {
-    "not scaled": (lambda V, F, sigma, seed: V + sigma * _normals(V, sigma, seed),
-                   "not scaled by the bounding box"),
-    "mean edge": (lambda V, F, sigma, seed: V + sigma * mean_edge_length(V, F) * _normals(V, sigma, seed),
-                  "mean edge length"),
-    "sigma as variance": (lambda V, F, sigma, seed: V + sigma ** 2 * bounding_box_diagonal(V)
-                          * _normals(V, sigma, seed), "variance"),
-    "variance for std": (lambda V, F, sigma, seed: V + (sigma * bounding_box_diagonal(V)) ** 2
-                         * _normals(V, sigma, seed), "variance s^2"),
-    "same vector": (lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V)
-                    * np.random.default_rng(seed).standard_normal(3), "same vector"),
-    "in place": (lambda V, F, sigma, seed: V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed)),
-                 "modified in place"),
-    "in place, copy returned": (lambda V, F, sigma, seed: np.copy(V.__iadd__(
-        sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed))), "modified in place"),
-    "not seeded": (lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.standard_normal(V.shape),
-                   "not seeded"),
-    "uniform": (lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.sqrt(3)
-                * np.random.default_rng(seed).uniform(-1, 1, V.shape), "not Gaussian"),
+    "not scaled": (lambda V, F, sigma, seed: V + sigma * _normals(V, sigma, seed), "not scaled by the bounding box"),
+    "mean edge": (
+        lambda V, F, sigma, seed: V + sigma * mean_edge_length(V, F) * _normals(V, sigma, seed),
+        "mean edge length",
+    ),
+    "sigma as variance": (
+        lambda V, F, sigma, seed: V + sigma**2 * bounding_box_diagonal(V) * _normals(V, sigma, seed),
+        "variance",
+    ),
+    "variance for std": (
+        lambda V, F, sigma, seed: V + (sigma * bounding_box_diagonal(V)) ** 2 * _normals(V, sigma, seed),
+        "variance s^2",
+    ),
+    "same vector": (
+        lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.default_rng(seed).standard_normal(3),
+        "same vector",
+    ),
+    "in place": (
+        lambda V, F, sigma, seed: V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed)),
+        "modified in place",
+    ),
+    "in place, copy returned": (
+        lambda V, F, sigma, seed: np.copy(V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed))),
+        "modified in place",
+    ),
+    "not seeded": (
+        lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.standard_normal(V.shape),
+        "not seeded",
+    ),
+    "uniform": (
+        lambda V, F, sigma, seed: (
+            V + sigma * bounding_box_diagonal(V) * np.sqrt(3) * np.random.default_rng(seed).uniform(-1, 1, V.shape)
+        ),
+        "not Gaussian",
+    ),
     "random direction of length s": (
-        lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V)
-        * (lambda X: X / np.linalg.norm(X, axis=1, keepdims=True))(_normals(V, sigma, seed)), "length about s"),
+        lambda V, F, sigma, seed: (
+            V
+            + sigma
+            * bounding_box_diagonal(V)
+            * (lambda X: X / np.linalg.norm(X, axis=1, keepdims=True))(_normals(V, sigma, seed))
+        ),
+        "length about s",
+    ),
     "list": (lambda V, F, sigma, seed: noise_reference(V, F, sigma, seed).tolist(), "not a numpy array"),
-    "one coordinate": (lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V)
-                       * _normals(V, sigma, seed) * [1, 1, 0], "not equally noisy"),
+    "one coordinate": (
+        lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed) * [1, 1, 0],
+        "not equally noisy",
+    ),
 }
 
 
@@ -63,12 +88,21 @@ def _e2(V, V_clean):
 
 WRONG_RMS = {
     "not relative": (lambda V, W: float(np.sqrt(_e2(V, W).mean())), "not relative"),
-    "mean of norms": (lambda V, W: float(np.sqrt(_e2(V, W)).mean()) / bounding_box_diagonal(W), "mean of the distances"),
+    "mean of norms": (
+        lambda V, W: float(np.sqrt(_e2(V, W)).mean()) / bounding_box_diagonal(W),
+        "mean of the distances",
+    ),
     "not rooted": (lambda V, W: float(_e2(V, W).mean()) / bounding_box_diagonal(W), "not rooted"),
     "squared ratio": (lambda V, W: float(_e2(V, W).mean()) / bounding_box_diagonal(W) ** 2, "not rooted"),
     "summed": (lambda V, W: float(np.sqrt(_e2(V, W).sum())) / bounding_box_diagonal(W), "summed"),
-    "noisy diagonal": (lambda V, W: float(np.sqrt(_e2(V, W).mean())) / bounding_box_diagonal(V), "noisy mesh's diagonal"),
-    "over coordinates": (lambda V, W: float(np.sqrt(np.mean((V - W) ** 2))) / bounding_box_diagonal(W), "3n coordinates"),
+    "noisy diagonal": (
+        lambda V, W: float(np.sqrt(_e2(V, W).mean())) / bounding_box_diagonal(V),
+        "noisy mesh's diagonal",
+    ),
+    "over coordinates": (
+        lambda V, W: float(np.sqrt(np.mean((V - W) ** 2))) / bounding_box_diagonal(W),
+        "3n coordinates",
+    ),
     "per vertex": (lambda V, W: np.sqrt(_e2(V, W)) / bounding_box_diagonal(W), "not one number"),
 }
 

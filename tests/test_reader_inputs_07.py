@@ -10,9 +10,8 @@ is kept small (one or two noise levels, a few iteration counts) to bound the
 time; its size is a parameter like any other.
 """
 
-import pytest
-
 import awkward_meshes
+import pytest
 from meshdata import COURSE, needs_course
 from notebook_runner import Raw, run_notebook
 
@@ -40,31 +39,63 @@ def _said(run, *phrases):
 
 def test_scan_with_holes_and_the_clean_cad_part(awkward):
     """The reader's case of issue 11: a scan with holes and unused vertices, and a clean CAD part."""
-    run = _run(SMOOTH_MESH=str(awkward["scan_with_holes"]), CAD_MESH=str(awkward["cad_part"]),
-               SIGMAS=(0.002, 0.02), ITERATIONS=(1, 3), DENOISE_ITERATIONS=20)
+    run = _run(
+        SMOOTH_MESH=str(awkward["scan_with_holes"]),
+        CAD_MESH=str(awkward["cad_part"]),
+        SIGMAS=(0.002, 0.02),
+        ITERATIONS=(1, 3),
+        DENOISE_ITERATIONS=20,
+    )
     _said(run, "not used by any face", "remove_unreferenced_vertices", "The mesh is open")
     assert "volume" in run.outputs_text()
 
 
 def test_two_components_a_cube_and_the_low_ends(awkward):
     """Lower ends: no noise at all, one iteration, strict thresholds, no denoising iterations, scale-free steps."""
-    run = _run(SMOOTH_MESH=str(awkward["two_components"]), CAD_MESH=Raw('geomlib.data_path("cube.obj")'),
-               SIGMAS=(0.0, 0.1), ITERATIONS=(1,), SHARP_ANGLE=5.0, NORMAL_OK=0.5, SHARP_OK=1.0,
-               SWEEP_MAX_VERTICES=10 ** 7, DENOISE_SIGMA=0.0, DENOISE_STEP=0.05, STEP_UNIT="tau/ell^2",
-               DENOISE_WEIGHTS="uniform", DENOISE_ITERATIONS=0, TAUBIN=(1.0, -1.0))
+    run = _run(
+        SMOOTH_MESH=str(awkward["two_components"]),
+        CAD_MESH=Raw('geomlib.data_path("cube.obj")'),
+        SIGMAS=(0.0, 0.1),
+        ITERATIONS=(1,),
+        SHARP_ANGLE=5.0,
+        NORMAL_OK=0.5,
+        SHARP_OK=1.0,
+        SWEEP_MAX_VERTICES=10**7,
+        DENOISE_SIGMA=0.0,
+        DENOISE_STEP=0.05,
+        STEP_UNIT="tau/ell^2",
+        DENOISE_WEIGHTS="uniform",
+        DENOISE_ITERATIONS=0,
+        TAUBIN=(1.0, -1.0),
+    )
     # without noise there is nothing to remove: the claims about improving on the noisy input become notes
-    _said(run, "smoothing always helps", "at sigma 0 no setting of the sweep beats the noisy input",
-          "too little noise to remove", "implicit smoothing with the assignment's values reduces the RMS",
-          "0 iterations")
+    _said(
+        run,
+        "smoothing always helps",
+        "at sigma 0 no setting of the sweep beats the noisy input",
+        "too little noise to remove",
+        "implicit smoothing with the assignment's values reduces the RMS",
+        "0 iterations",
+    )
     assert "tau/ell^2" in run.outputs_text()
 
 
 def test_open_plane_millimetres_and_the_high_ends(awkward):
     """Upper ends: the most noise, the longest runs, loose thresholds, the sweep cut to the middle level."""
-    run = _run(SMOOTH_MESH=Raw('geomlib.data_path("plane.obj")'), CAD_MESH=str(awkward["y_up_millimetres"]),
-               SIGMAS=(0.05, 0.1), ITERATIONS=(100,), SHARP_ANGLE=90.0, NORMAL_OK=30.0, SHARP_OK=45.0,
-               SWEEP_MAX_VERTICES=1000, DENOISE_SIGMA=0.1, DENOISE_STEP=1e-3, DENOISE_ITERATIONS=1000,
-               TAUBIN=(0.5, -0.53))
+    run = _run(
+        SMOOTH_MESH=Raw('geomlib.data_path("plane.obj")'),
+        CAD_MESH=str(awkward["y_up_millimetres"]),
+        SIGMAS=(0.05, 0.1),
+        ITERATIONS=(100,),
+        SHARP_ANGLE=90.0,
+        NORMAL_OK=30.0,
+        SHARP_OK=45.0,
+        SWEEP_MAX_VERTICES=1000,
+        DENOISE_SIGMA=0.1,
+        DENOISE_STEP=1e-3,
+        DENOISE_ITERATIONS=1000,
+        TAUBIN=(0.5, -0.53),
+    )
     _said(run, "The mesh is open", "SWEEP_MAX_VERTICES = 1000", "middle noise level")
     # the sphere in millimetres has no sharp edges: the claims about them are skipped, not failed
     assert "mean edge lengths" in run.outputs_text()
@@ -73,6 +104,11 @@ def test_open_plane_millimetres_and_the_high_ends(awkward):
 @needs_course
 def test_course_meshes():
     """The course's bunny as the smooth mesh; its noisy fandisk as the 'clean' part (a reader's likely mistake)."""
-    run = _run(SMOOTH_MESH=str(COURSE / "bunny.obj"), CAD_MESH=str(COURSE / "smoothing" / "fandisk_ns.obj"),
-               SIGMAS=(0.005,), ITERATIONS=(1, 5), DENOISE_ITERATIONS=50)
+    run = _run(
+        SMOOTH_MESH=str(COURSE / "bunny.obj"),
+        CAD_MESH=str(COURSE / "smoothing" / "fandisk_ns.obj"),
+        SIGMAS=(0.005,),
+        ITERATIONS=(1, 5),
+        DENOISE_ITERATIONS=50,
+    )
     assert "CAD mesh** (7229 vertices)" in run.outputs_text()
