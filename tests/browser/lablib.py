@@ -347,3 +347,13 @@ def changed_fraction(png_a, png_b):
     if a.shape != b.shape:
         return 1.0
     return float(np.any(np.abs(a - b) > 8, axis=2).mean())
+
+
+def wait_for(predicate, timeout, interval=0.3):
+    """Call ``predicate`` until it returns something true or ``timeout`` seconds pass; return its last value."""
+    deadline = time.monotonic() + timeout
+    value = predicate()
+    while not value and time.monotonic() < deadline:
+        time.sleep(interval)
+        value = predicate()
+    return value

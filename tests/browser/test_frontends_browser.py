@@ -15,7 +15,6 @@ Screenshots: build/screenshots/NAME/.
 """
 
 import importlib.util
-import time
 from pathlib import Path
 
 import lablib
@@ -71,15 +70,6 @@ def newcomer_lab_server(browser):
         server.stop()
 
 
-def _wait_for(predicate, timeout, interval=0.3):
-    deadline = time.monotonic() + timeout
-    value = predicate()
-    while not value and time.monotonic() < deadline:
-        time.sleep(interval)
-        value = predicate()
-    return value
-
-
 def _screenshots(name):
     folder = ROOT / "build" / "screenshots" / name
     folder.mkdir(parents=True, exist_ok=True)
@@ -113,7 +103,7 @@ def _first_contact(browser, server):
         page.goto(f"{server.url}/?token={server.token}", wait_until="domcontentloaded", timeout=120_000)
         page.wait_for_function(JS_OPEN_DOCUMENT, timeout=120_000, polling=250)
         opened = page.evaluate(JS_OPEN_DOCUMENT)
-        interruptions = _wait_for(lambda: page.evaluate(JS_INTERRUPTIONS), WATCH, interval=0.5)
+        interruptions = lablib.wait_for(lambda: page.evaluate(JS_INTERRUPTIONS), WATCH, interval=0.5)
         page.screenshot(path=str(_screenshots(f"first_contact_{server.app}") / "page.png"))
         return opened, interruptions
     finally:
@@ -156,7 +146,7 @@ def test_notebook_in_notebook7(notebook, browser, notebook7_server):
                 shot["png"] = lablib.stable_screenshot(canvas)
                 return _drawn(shot["png"])
 
-            ok = _wait_for(drawn, RENDER_TIMEOUT)
+            ok = lablib.wait_for(drawn, RENDER_TIMEOUT)
             (screenshot_dir / f"canvas{i}.png").write_bytes(shot["png"])
             assert ok, f"view {i} of {notebook} is blank in Notebook 7"
 
@@ -176,7 +166,7 @@ def test_notebook_in_notebook7(notebook, browser, notebook7_server):
             moved["after"] = after
             return moved["fraction"] > 0.005
 
-        ok = _wait_for(changed, RENDER_TIMEOUT, interval=0.5)
+        ok = lablib.wait_for(changed, RENDER_TIMEOUT, interval=0.5)
         (screenshot_dir / "slider_after.png").write_bytes(moved["after"][0])
         assert ok, f"{notebook}: the slider '{found['description']}' changed {moved['fraction']:.2%} of the view"
         state = page.evaluate(lablib.JS_STATE)

@@ -31,15 +31,6 @@ RENDER_TIMEOUT = 30  # seconds for a view to show a picture / react to a slider
 pytestmark = pytest.mark.browser
 
 
-def _wait_for(predicate, timeout, interval=0.3):
-    deadline = time.monotonic() + timeout
-    value = predicate()
-    while not value and time.monotonic() < deadline:
-        time.sleep(interval)
-        value = predicate()
-    return value
-
-
 def _not_blank(png):
     distinct, covered = lablib.image_stats(png)
     return distinct >= 20 and covered >= 0.01, distinct, covered
@@ -79,7 +70,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 shot["png"] = lablib.stable_screenshot(canvas)
                 return _not_blank(shot["png"])[0]
 
-            ok = _wait_for(rendered, RENDER_TIMEOUT)
+            ok = lablib.wait_for(rendered, RENDER_TIMEOUT)
             (screenshot_dir / f"canvas{i}.png").write_bytes(shot["png"])
             _, distinct, covered = _not_blank(shot["png"])
             assert ok, (
@@ -107,7 +98,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             moved["fraction"] = max(lablib.changed_fraction(a, b) for a, b in zip(before, moved["after"]))
             return moved["fraction"] > 0.005
 
-        ok = _wait_for(changed, RENDER_TIMEOUT, interval=0.5)
+        ok = lablib.wait_for(changed, RENDER_TIMEOUT, interval=0.5)
         for i, png in enumerate(moved["after"]):
             (screenshot_dir / f"slider_after{i}.png").write_bytes(png)
         page.screenshot(path=str(screenshot_dir / "page_after_slider.png"))
@@ -119,7 +110,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         assert not state["errors"], f"the slider callback raised:\n{_format_errors(state['errors'])}"
 
         # 5: linked cameras turn together (after the slider's work has finished)
-        _wait_for(lambda: page.evaluate(lablib.JS_STATE)["kernel"] == "idle", RUN_TIMEOUT)
+        lablib.wait_for(lambda: page.evaluate(lablib.JS_STATE)["kernel"] == "idle", RUN_TIMEOUT)
         time.sleep(1.0)
         rows = page.locator(".geomlib-row")
         for r in range(rows.count()):
@@ -137,12 +128,12 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 page.mouse.down()
                 page.mouse.move(x + 90, y + 40, steps=10)
                 page.mouse.up()
-                turned = _wait_for(
+                turned = lablib.wait_for(
                     lambda: lablib.changed_fraction(before_first, lablib.stable_screenshot(first)) > 0.005, 10
                 )
                 if not turned:
                     continue
-                followed = _wait_for(
+                followed = lablib.wait_for(
                     lambda: lablib.changed_fraction(before_second, lablib.stable_screenshot(second)) > 0.005,
                     RENDER_TIMEOUT,
                 )

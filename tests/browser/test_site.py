@@ -31,7 +31,6 @@ import os
 import re
 import sys
 import threading
-import time
 from pathlib import Path
 
 import lablib
@@ -145,15 +144,6 @@ JS_CONTROLS = """
 """
 
 
-def _wait_for(predicate, timeout, interval=0.5):
-    deadline = time.monotonic() + timeout
-    value = predicate()
-    while not value and time.monotonic() < deadline:
-        time.sleep(interval)
-        value = predicate()
-    return value
-
-
 def _not_blank(png):
     distinct, covered = lablib.image_stats(png)
     return distinct >= 20 and covered >= 0.01
@@ -167,14 +157,14 @@ def _shot_if(canvas, accept):
 def _check_canvases(page, expected, shots):
     """Every canvas drawn and turned by a drag; returns the number of canvases."""
     canvases = page.locator("canvas")
-    assert _wait_for(lambda: canvases.count() >= expected, LOAD_TIMEOUT), (
+    assert lablib.wait_for(lambda: canvases.count() >= expected, LOAD_TIMEOUT), (
         f"{canvases.count()} canvases appeared; the build saved {expected} live views"
     )
     for i in range(canvases.count()):
         canvas = canvases.nth(i)
         canvas.scroll_into_view_if_needed()
         canvas.hover()  # a view frozen to a picture comes back to life when the mouse enters
-        before = _wait_for(lambda canvas=canvas: _shot_if(canvas, _not_blank), 30)
+        before = lablib.wait_for(lambda canvas=canvas: _shot_if(canvas, _not_blank), 30)
         assert before, f"canvas {i} stays blank"
         (shots / f"canvas{i}.png").write_bytes(before)
         box = canvas.bounding_box()
@@ -183,7 +173,7 @@ def _check_canvases(page, expected, shots):
         page.mouse.down()
         page.mouse.move(x + 90, y + 25, steps=12)
         page.mouse.up()
-        after = _wait_for(
+        after = lablib.wait_for(
             lambda canvas=canvas, before=before: _shot_if(
                 canvas, lambda png: lablib.changed_fraction(before, png) > 0.01
             ),
@@ -292,9 +282,9 @@ def test_stills_show_without_webgl(site, site_url, browser):
         view.page.goto(site_url + name, wait_until="load")
         stills = view.page.locator("img.site-still")
         assert stills.count() > 0, "the page holds no still pictures of its views"
-        assert _wait_for(lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30), (
-            f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
-        )
+        assert lablib.wait_for(
+            lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30
+        ), f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
         for i in range(stills.count()):
             assert _not_blank(lablib.stable_screenshot(stills.nth(i))), f"still {i} is blank"
         assert not view.outside, f"requests to the network: {view.outside}"
