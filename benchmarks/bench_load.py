@@ -30,7 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import trimesh  # noqa: E402
 
 from geomlib import check_mesh, load_mesh, save_mesh  # noqa: E402
-from geomlib.io import _read_obj  # noqa: E402
+from geomlib.io import parse_obj  # noqa: E402
 
 
 def latlong_sphere(n_target, n_lon=1000):
@@ -93,7 +93,7 @@ def main():
             ours.append(median_time(lambda: load_mesh(path), 1)[0])
             trim.append(median_time(lambda: trimesh.load(path, process=False), 1)[0])
         data = path.read_bytes()
-        t_parse, _ = median_time(lambda: _read_obj(data, str(path)), args.repeats)
+        t_parse, _ = median_time(lambda: parse_obj(data, str(path)), args.repeats)
         t_check, _ = median_time(lambda: check_mesh(V1, F1), args.repeats)
 
     mo, mt = statistics.median(ours), statistics.median(trim)

@@ -9,7 +9,7 @@ the mesh's own units.
 import numpy as np
 
 from .topology import edges
-from .validate import as_faces, as_mesh, as_vertices
+from .validate import ZERO_AREA_RTOL, as_faces, as_mesh, as_vertices, is_zero_area
 
 __all__ = [
     "corner_positions",
@@ -17,6 +17,7 @@ __all__ = [
     "face_cross",
     "face_areas",
     "face_normals",
+    "zero_area_faces",
     "vertex_normals",
     "surface_area",
     "enclosed_volume",
@@ -43,6 +44,20 @@ def face_cross(V, F):
     """(m, 3) float64: ``(v1 - v0) x (v2 - v0)`` per face, which is 2 A_f n_f (unchecked input)."""
     v0, v1, v2 = corner_positions(V, F)
     return cross(v1 - v0, v2 - v0).T
+
+
+def zero_area_faces(V, F, rtol=ZERO_AREA_RTOL):
+    """Indices (k,) int64 of the faces whose area is zero up to rounding (:func:`geomlib.validate.is_zero_area`).
+
+    Faces with a repeated vertex never reach here (``validate.as_mesh`` refuses them).
+    """
+    V, F = as_mesh(V, F)
+    v0, v1, v2 = corner_positions(V, F)
+    dblA = np.sqrt((cross(v1 - v0, v2 - v0) ** 2).sum(axis=0))
+    longest2 = np.max(
+        [((v1 - v0) ** 2).sum(axis=0), ((v2 - v1) ** 2).sum(axis=0), ((v0 - v2) ** 2).sum(axis=0)], axis=0
+    )
+    return np.flatnonzero(is_zero_area(dblA, longest2, rtol))
 
 
 def face_areas(V, F):

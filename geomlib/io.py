@@ -70,7 +70,7 @@ from .errors import MeshError, MeshWarning, count_text, format_indices
 from .report import check_mesh
 from .validate import as_mesh, as_vertices
 
-__all__ = ["load_mesh", "save_mesh", "SUPPORTED_EXTENSIONS"]
+__all__ = ["load_mesh", "save_mesh", "parse_obj", "SUPPORTED_EXTENSIONS"]
 
 SUPPORTED_EXTENSIONS = (".obj", ".off", ".ply", ".stl")
 
@@ -273,7 +273,7 @@ def _obj_bad_line(data, starts, ends, idx, where):
     raise MeshError(f"{where}: cannot read the numbers of the v and f lines")  # not reached for valid bytes
 
 
-def _read_obj(data, where):
+def parse_obj(data, where):
     """(V, F, notes) from the bytes of an OBJ file; ``notes`` lists what was ignored."""
     data = _obj_lines(data)
     starts, ends = _line_bounds(data)
@@ -569,7 +569,7 @@ def load_mesh(path, report=False):
         raise MeshError(f"{where}: the file is empty")
     notes = []
     if ext == ".obj":
-        V, F, notes = _read_obj(data, where)
+        V, F, notes = parse_obj(data, where)
     elif ext == ".off":
         V, F = _read_off(data, where)
     else:

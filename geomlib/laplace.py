@@ -261,6 +261,3 @@ def uniform_adjacency(n, F):
     A.eliminate_zeros()
     return A
 
-
-# geomlib.smoothing still imports the validator under this name; it goes once smoothing calls validate.as_mesh
-_as_mesh = as_mesh

@@ -19,8 +19,9 @@ back to the file's vertices (``values_in_file = full(n); values_in_file[kept] = 
 
 import numpy as np
 
+from .geometry import zero_area_faces
 from .topology import boundary_vertices, connected_components
-from .validate import as_mesh, zero_area_faces
+from .validate import as_mesh
 
 __all__ = ["remove_unreferenced_vertices", "largest_component", "remove_zero_area_faces", "prepare"]
 
@@ -62,7 +63,7 @@ def largest_component(V, F):
 
 
 def remove_zero_area_faces(V, F):
-    """Drop faces whose area is zero up to rounding (``validate.zero_area_faces``).
+    """Drop faces whose area is zero up to rounding (``geometry.zero_area_faces``).
 
     Returns (V, F2, kept_faces): the vertices unchanged, the faces kept and their indices.
     """

@@ -15,8 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import count_text, format_indices
+from .geometry import zero_area_faces
 from .topology import Topology, loops_from_edges
-from .validate import as_mesh, zero_area_faces
+from .validate import as_mesh
 
 __all__ = ["check_mesh", "MeshReport"]
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from .errors import MeshError, count_text, format_indices
 
-__all__ = ["as_mesh", "as_faces", "as_vertices", "is_zero_area", "zero_area_faces", "ZERO_AREA_RTOL"]
+__all__ = ["as_mesh", "as_faces", "as_vertices", "is_zero_area", "ZERO_AREA_RTOL"]
 
 # A face counts as zero-area when twice its area is at most this fraction of
 # its longest edge squared, i.e. its height over the longest edge is below
@@ -187,22 +187,3 @@ def is_zero_area(dblA, longest2, rtol=ZERO_AREA_RTOL):
     squared (arrays of the same shape); returns a boolean array.
     """
     return dblA <= rtol * longest2
-
-
-def zero_area_faces(V, F, rtol=ZERO_AREA_RTOL):
-    """Indices (k,) int64 of the faces whose area is zero up to rounding (:func:`is_zero_area`).
-
-    Faces with a repeated vertex never reach here (:func:`as_mesh` refuses them).
-    """
-    V, F = as_mesh(V, F)
-    # coordinate by coordinate (validate sits below geometry, so it cannot call geometry.face_cross)
-    X, Y, Z = np.ascontiguousarray(V.T)
-    i, j, k = np.ascontiguousarray(F.T)
-    ax, ay, az = X[j] - X[i], Y[j] - Y[i], Z[j] - Z[i]  # a = v1 - v0
-    bx, by, bz = X[k] - X[i], Y[k] - Y[i], Z[k] - Z[i]  # b = v2 - v0
-    dblA = np.sqrt((ay * bz - az * by) ** 2 + (az * bx - ax * bz) ** 2 + (ax * by - ay * bx) ** 2)
-    longest2 = np.maximum(
-        np.maximum(ax * ax + ay * ay + az * az, bx * bx + by * by + bz * bz),
-        (bx - ax) ** 2 + (by - ay) ** 2 + (bz - az) ** 2,
-    )
-    return np.flatnonzero(is_zero_area(dblA, longest2, rtol))

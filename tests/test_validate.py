@@ -266,7 +266,8 @@ def test_course_boundary_loops(name, loops):
 
 
 def test_is_zero_area_is_scale_free_and_zero_area_faces_uses_it():
-    from geomlib.validate import is_zero_area, zero_area_faces
+    from geomlib.geometry import zero_area_faces
+    from geomlib.validate import is_zero_area
 
     assert is_zero_area(np.array([0.0, 1e-13, 1e-11]), np.ones(3)).tolist() == [True, True, False]
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1e-14, 0]])
