@@ -260,4 +260,3 @@ def uniform_adjacency(n, F):
     A = (C + M).tocsr()
     A.eliminate_zeros()
     return A
-
