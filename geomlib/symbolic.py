@@ -249,17 +249,7 @@ class ParametricSurface:
             raise ValueError(f"unknown parameter(s) {bad}; this surface has {sorted(by_name)}")
         merged = dict(self.values)
         merged.update({by_name[k]: x for k, x in values.items()})
-        return ParametricSurface(
-            None,
-            fam.u,
-            fam.v,
-            params=fam.params,
-            values=merged,
-            orientation=fam.orientation,
-            name=fam.name,
-            closed=fam.closed,
-            _family=fam,
-        )
+        return _specialised(fam, merged)
 
     def _check_normal_hint(self, check_values):
         """Check p_u x p_v = orientation * area_factor * D numerically at random points."""
@@ -723,12 +713,17 @@ def _member(family, args):
             raise ValueError(f"{family.name}: parameter {s} must be positive, got {x}")
     if all(vals[s] == s for s in family.params):
         return family
+    return _specialised(family, vals)
+
+
+def _specialised(family, values):
+    """The member of ``family`` with its parameters set to ``values`` (shares the family's cache)."""
     return ParametricSurface(
         None,
         family.u,
         family.v,
         params=family.params,
-        values=vals,
+        values=values,
         orientation=family.orientation,
         name=family.name,
         closed=family.closed,

@@ -106,16 +106,7 @@ def cotangent_laplacian(fn):
             )
         if close(M, np.eye(len(V))):
             raise Mistake("M is the identity", "M = diag(A_i), a third of the areas of the triangles around i")
-        if close(M, 3 * M_ref):
-            raise Mistake(
-                "M is not divided by 3: each vertex gets the whole area of its triangles",
-                "A_i = 1/3 of the sum of the incident triangle areas",
-            )
-        if close(M, 2 * M_ref) or close(M, 6 * M_ref):
-            raise Mistake(
-                "M uses twice the triangle areas (the length of the cross product is 2 A)",
-                "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2",
-            )
+        _check_area_scale(M, M_ref, "M")
         if np.count_nonzero(M[off]):
             raise Mistake("M is not diagonal", "M = diag(A_i): the lumped (diagonal) mass matrix")
         if not close(M, M_ref):
@@ -125,6 +116,20 @@ def cotangent_laplacian(fn):
             )
         checked.append(label)
     return checked
+
+
+def _check_area_scale(A, ref, what):
+    """The two scale mistakes of barycentric areas (A or M against the reference ``ref``)."""
+    if close(A, 3 * ref):
+        raise Mistake(
+            f"{what} is not divided by 3: each vertex gets the whole area of its triangles",
+            "a triangle gives a third of its area to each of its corners",
+        )
+    if close(A, 2 * ref) or close(A, 6 * ref):
+        raise Mistake(
+            f"{what} uses twice the triangle area (the length of the cross product is 2 A)",
+            "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2",
+        )
 
 
 def _areas(fn, V, F, what):
@@ -144,16 +149,7 @@ def vertex_areas(fn):
     for label, V, F in (("one obtuse triangle", _OBTUSE_V, _OBTUSE_F),) + _CASES:
         A = _areas(fn, V, F, "the function")
         ref = laplace.vertex_areas(V, F, "barycentric")
-        if close(A, 3 * ref):
-            raise Mistake(
-                "the area is not divided by 3: each vertex gets the sum of its triangles' areas",
-                "a triangle gives a third of its area to each of its corners",
-            )
-        if close(A, 2 * ref) or close(A, 6 * ref):
-            raise Mistake(
-                "twice the triangle area is used (the length of the cross product is 2 A)",
-                "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2",
-            )
+        _check_area_scale(A, ref, "the area")
         if label == "one obtuse triangle" and close(A, laplace.vertex_areas(V, F, "mixed")):
             raise Mistake(
                 "these are the mixed (Voronoi) areas, not the barycentric ones",
