@@ -62,6 +62,7 @@ _EXPORTS = {
     "implicit_smoothing": "smoothing",
     "explicit_step_limit": "smoothing",
     "highest_frequency_mode": "smoothing",
+    "fixed_point": "smoothing",
     "ImplicitSmoother": "smoothing",
     # noise and evaluation
     "add_noise": "noise",

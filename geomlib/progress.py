@@ -2,10 +2,13 @@
 
 import time
 
-__all__ = ["SECONDS", "Iterations", "Stages"]
+__all__ = ["SECONDS", "LARGE_MESH", "Iterations", "Stages", "loop"]
 
 #: Runs estimated to take longer than this many seconds show a progress bar.
 SECONDS = 2.0
+
+#: Vertices: a notebook's loop over meshes at least this large takes seconds per item.
+LARGE_MESH = 50_000
 
 
 class Iterations:
@@ -65,3 +68,11 @@ class Stages:
     def __exit__(self, *exc):
         if self.bar is not None:
             self.bar.close()
+
+
+def loop(items, desc, vertices):
+    """``items``, with a progress bar when the largest mesh of the loop has more than
+    :data:`LARGE_MESH` vertices (``vertices``); for the notebooks' loops over meshes."""
+    from tqdm.auto import tqdm
+
+    return tqdm(items, desc=desc, leave=False, disable=vertices <= LARGE_MESH)

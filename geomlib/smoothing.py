@@ -55,6 +55,7 @@ __all__ = [
     "implicit_smoothing",
     "explicit_step_limit",
     "highest_frequency_mode",
+    "fixed_point",
     "ImplicitSmoother",
 ]
 
@@ -167,6 +168,33 @@ def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="
         _remember(name, (lam_max, e))
     lam_max, e = _REMEMBERED[name]
     return lam_max, e.copy()
+
+
+def fixed_point(V, F, weights="cotan", area="barycentric"):
+    """``P*``, where smoothing with the operator fixed and the boundary fixed ends up: ``C P* = 0`` off the boundary.
+
+    Closed mesh: every vertex at the area-weighted centroid ``sum_i m_i v_i / sum_i m_i``
+    (the constant mode, the only one with ``lambda = 0``). Open mesh: the boundary
+    vertices stay at V and the interior solves ``C_II P*_I = -C_IB V_B``, the
+    membrane spanned by the boundary (harmonic coordinates; for cotan weights a flat
+    mesh is its own membrane, by linear precision). Every other mode of
+    ``P - P*`` decays under both schemes of notebooks 05 and 06.
+
+    Returns
+    -------
+    P_star : (n, 3) float64, length units.
+    """
+    V, F = as_mesh(V, F)
+    M, C = laplacian(V, F, weights=weights, area=area)
+    m = M.diagonal()
+    B = boundary_vertices(F, len(V))
+    if len(B) == 0:
+        return np.repeat([m @ V / m.sum()], len(V), axis=0)
+    I = np.setdiff1d(np.arange(len(V)), B)
+    C = C.tocsr()
+    P_star = V.copy()
+    P_star[I] = factorise(-C[I][:, I]).solve(C[I][:, B] @ V[B])  # -C_II is positive definite
+    return P_star
 
 
 _REMEMBERED = {}

@@ -145,3 +145,12 @@ def test_braces_in_the_values_are_not_placeholders(shown, monkeypatch):
         shown[0]["text/plain"]
         == f"{NOTE_PREFIX} The text says the set is {{1, 2}}. With these inputs it does not hold: $\\frac{{1}}{{2}}$ differs"
     )
+
+
+def test_loop_over_meshes_shows_a_bar_only_for_large_meshes(capsys):
+    from geomlib.progress import LARGE_MESH, loop
+
+    assert list(loop(range(3), "small meshes", LARGE_MESH)) == [0, 1, 2]
+    assert capsys.readouterr().err == ""
+    assert list(loop(range(3), "large meshes", LARGE_MESH + 1)) == [0, 1, 2]
+    assert "large meshes" in capsys.readouterr().err

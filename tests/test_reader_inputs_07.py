@@ -63,7 +63,7 @@ def test_two_components_a_cube_and_the_low_ends(awkward):
         SWEEP_MAX_VERTICES=10**7,
         DENOISE_SIGMA=0.0,
         DENOISE_STEP=0.05,
-        STEP_UNIT="tau/ell^2",
+        STEP_UNIT="ell^2",
         DENOISE_WEIGHTS="uniform",
         DENOISE_ITERATIONS=0,
         TAUBIN=(1.0, -1.0),
@@ -77,7 +77,7 @@ def test_two_components_a_cube_and_the_low_ends(awkward):
         "implicit smoothing with the assignment's values reduces the RMS",
         "0 iterations",
     )
-    assert "tau/ell^2" in run.outputs_text()
+    assert "step given 0.05 (ell^2)" in run.outputs_text()
 
 
 def test_open_plane_millimetres_and_the_high_ends(awkward):

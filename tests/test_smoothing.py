@@ -10,7 +10,14 @@ import trimesh
 from meshdata import COURSE
 
 from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_limit, implicit_smoothing, laplacian
-from geomlib.smoothing import ImplicitSmoother, _volume_centroid, explicit_step, highest_frequency_mode, implicit_step
+from geomlib.smoothing import (
+    ImplicitSmoother,
+    _volume_centroid,
+    explicit_step,
+    fixed_point,
+    highest_frequency_mode,
+    implicit_step,
+)
 from geomlib.topology import boundary_vertices
 
 
@@ -65,6 +72,41 @@ def test_plane_stays_planar(weights, boundary):
     assert np.abs(P - V).max() > 1e-3  # it did move (in the plane)
     Q = implicit_smoothing(V, F, 50 * limit, 5, weights, boundary=boundary)
     assert plane_distance(Q) < 1e-12
+
+
+# ---------------------------------------------------------------------------
+# the fixed point P*
+
+
+def test_fixed_point_of_a_flat_mesh_is_itself_with_cotan_weights():
+    """Linear precision: on a flat (tilted, irregular) grid every coordinate is cotan-harmonic."""
+    V, F = grid(12, jitter=0.3)  # no triangle folds over
+    V = tilt(V)
+    assert np.abs(fixed_point(V, F) - V).max() < 1e-12
+
+
+def test_fixed_point_of_a_bumpy_open_mesh_is_its_membrane():
+    V, F = grid(12)
+    inner = ~_boundary_mask(F, len(V))
+    W = V.copy()
+    W[inner, 2] = np.random.default_rng(3).normal(0, 0.05, inner.sum())  # bumps inside, flat boundary
+    P = fixed_point(W, F)
+    assert np.abs(P[~inner] - W[~inner]).max() == 0  # the boundary stays
+    assert np.abs(P[:, 2]).max() < 1e-12  # zero boundary heights: a flat membrane
+    M, C = laplacian(W, F)
+    assert np.abs((C @ P)[inner]).max() < 1e-12  # harmonic inside, with W's own weights
+
+
+def test_fixed_point_of_a_closed_mesh_is_the_area_weighted_centroid():
+    V, F = icosphere(2, radius=2.0, centre=(1.0, -2.0, 0.5))
+    V = V * [1.0, 0.7, 0.4]
+    m = laplacian(V, F)[0].diagonal()
+    P = fixed_point(V, F)
+    assert P.shape == V.shape and np.ptp(P, axis=0).max() == 0
+    assert np.allclose(P[0], m @ V / m.sum(), rtol=0, atol=1e-14)
+    # explicit smoothing converges to it
+    Q = explicit_smoothing(V, F, 0.9 * explicit_step_limit(V, F), 3000)
+    assert np.abs(Q - P).max() < 1e-6
 
 
 def test_fixed_boundary_stays_and_free_boundary_moves():
