@@ -279,7 +279,7 @@ class ParametricSurface:
         """Cache; for family members take the family's result and substitute."""
         if key not in self._cache:
             if self._family is not None:
-                val = self._family._get(key, getattr(self._family, "_c_" + key))
+                val = self._family._get(key, getattr(self._family, "derive_" + key))
                 self._cache[key] = self._substitute(val)
             else:
                 self._cache[key] = compute()
@@ -288,22 +288,24 @@ class ParametricSurface:
     def _substitute(self, val):
         return _subs_tidy(val, self.values)
 
-    # ------------------------------------------------- family computations (_c_*)
+    # ------------------------------------------------- the derivations (derive_*)
+    # Each derive_X computes X from p(u, v) without the cache; the method X below
+    # returns it cached (and, for a family member, substituted from the family's).
     # Everything is kept in the structured form
     #   p_u x p_v = orientation * area_factor * D,   W = |D| = sqrt(D.D),
     #   e = e_n / W  with e_n = -p_uu . D  (likewise f, g),
     #   EG - F^2 = area_factor^2 W^2,
     # so that only polynomials in sin/cos are simplified and sqrt(W^2) never
     # needs an Abs.
-    def _c_tangents(self):
+    def derive_tangents(self):
         return (self.p.diff(self.u), self.p.diff(self.v))
 
-    def _c_first_fundamental_form(self):
+    def derive_first_fundamental_form(self):
         pu, pv = self.tangents()
         E, F, G = (_tidy(x) for x in (pu.dot(pu), pu.dot(pv), pv.dot(pv)))
         return sp.Matrix([[E, F], [F, G]])
 
-    def _c_normal_parts(self):
+    def derive_normal_parts(self):
         """(D, D.D, area_factor): n = D/|D|, p_u x p_v = orientation * area_factor * D."""
         if self._D is None:
             pu, pv = self.tangents()
@@ -312,23 +314,23 @@ class ParametricSurface:
         D = self._D.applyfunc(_tidy)
         return D, _tidy(D.dot(D)), self._area_factor
 
-    def _c_unit_normal(self):
+    def derive_unit_normal(self):
         D, DD, _ = self._normal_parts()
         return D / sp.sqrt(DD)
 
-    def _c_second_numerators(self):
+    def derive_second_numerators(self):
         """(e_n, f_n, g_n) = -(p_uu, p_uv, p_vv) . D: the second form times |D| (normal -n)."""
         D, _, _ = self._normal_parts()
         p, u, v = self.p, self.u, self.v
         return tuple(_tidy(-_dot(p.diff(x, y), D)) for x, y in ((u, u), (u, v), (v, v)))
 
-    def _c_second_fundamental_form(self):
+    def derive_second_fundamental_form(self):
         en, fn, gn = self._second_numerators()
         _, DD, _ = self._normal_parts()
         W = sp.sqrt(DD)
         return sp.Matrix([[en / W, fn / W], [fn / W, gn / W]])
 
-    def _c_curvature_numerators(self):
+    def derive_curvature_numerators(self):
         """(k_num, h_num): K = k_num / W^4, H = h_num / (2 W^3)."""
         en, fn, gn = self._second_numerators()
         _, DD, af = self._normal_parts()
@@ -338,36 +340,36 @@ class ParametricSurface:
         h_num = _tidy(sp.cancel((en * G - 2 * fn * F + gn * E) / af**2))
         return (k_num, h_num)
 
-    def _c_gaussian_curvature(self):
-        k_num, _ = self._get("curvature_numerators", self._c_curvature_numerators)
+    def derive_gaussian_curvature(self):
+        k_num, _ = self._get("curvature_numerators", self.derive_curvature_numerators)
         _, DD, _ = self._normal_parts()
         return k_num / DD**2
 
-    def _c_mean_curvature(self):
-        _, h_num = self._get("curvature_numerators", self._c_curvature_numerators)
+    def derive_mean_curvature(self):
+        _, h_num = self._get("curvature_numerators", self.derive_curvature_numerators)
         _, DD, _ = self._normal_parts()
         return h_num / (2 * DD ** sp.Rational(3, 2))
 
-    def _c_principal_curvatures(self):
+    def derive_principal_curvatures(self):
         # k = H +- sqrt(H^2 - K) = (h_num +- sqrt(h_num^2 - 4 k_num W^2)) / (2 W^3)
-        k_num, h_num = self._get("curvature_numerators", self._c_curvature_numerators)
+        k_num, h_num = self._get("curvature_numerators", self.derive_curvature_numerators)
         _, DD, _ = self._normal_parts()
         root = sp.sqrt(_tidy(h_num**2 - 4 * k_num * DD))
         den = 2 * DD ** sp.Rational(3, 2)
         return ((h_num + root) / den, (h_num - root) / den)
 
-    def _c_shape_operator(self):
+    def derive_shape_operator(self):
         en, fn, gn = self._second_numerators()
         _, DD, af = self._normal_parts()
         I = self.first_fundamental_form()
         num = I.adjugate() * sp.Matrix([[en, fn], [fn, gn]])
         return num.applyfunc(lambda x: _tidy(sp.cancel(x / af**2))) / DD ** sp.Rational(3, 2)
 
-    def _c_area_element(self):
+    def derive_area_element(self):
         _, DD, af = self._normal_parts()
         return af * sp.sqrt(DD)
 
-    def _c_frame(self):
+    def derive_frame(self):
         """(e1, w) = (p_u/|p_u|, (E p_v - F p_u) / (sqrt(E) sqrt(EG - F^2)))."""
         pu, pv = self.tangents()
         I = self.first_fundamental_form()
@@ -377,7 +379,7 @@ class ParametricSurface:
         wn = (E * pv - F * pu).applyfunc(lambda x: _tidy(sp.cancel(x / af)))
         return (e1, wn / (sp.sqrt(E) * sp.sqrt(DD)))
 
-    def _c_frame_coefficients(self):
+    def derive_frame_coefficients(self):
         """(A, B, C): the second form in the orthonormal frame (p_u/|p_u|, w).
 
         kappa_n(phi) = A cos^2 phi + 2 B sin phi cos phi + C sin^2 phi, with
@@ -396,47 +398,47 @@ class ParametricSurface:
     # ------------------------------------------------------ public, symbolic
     def tangents(self):
         """(p_u, p_v): the coordinate tangents as 3x1 sympy matrices (length units)."""
-        return self._get("tangents", self._c_tangents)
+        return self._get("tangents", self.derive_tangents)
 
     def first_fundamental_form(self):
         """I = [[E, F], [F, G]], E = p_u.p_u, F = p_u.p_v, G = p_v.p_v (length^2), 2x2 sympy Matrix."""
-        return self._get("first_fundamental_form", self._c_first_fundamental_form)
+        return self._get("first_fundamental_form", self.derive_first_fundamental_form)
 
     def _normal_parts(self):
-        return self._get("normal_parts", self._c_normal_parts)
+        return self._get("normal_parts", self.derive_normal_parts)
 
     def _second_numerators(self):
-        return self._get("second_numerators", self._c_second_numerators)
+        return self._get("second_numerators", self.derive_second_numerators)
 
     def unit_normal(self):
         """n: unit normal, outward on closed surfaces (3x1 sympy Matrix, dimensionless).
 
         The second fundamental form uses -n (see the module docstring).
         """
-        return self._get("unit_normal", self._c_unit_normal)
+        return self._get("unit_normal", self.derive_unit_normal)
 
     def second_fundamental_form(self):
         """II = [[e, f], [f, g]] with e = p_uu . N, N = -unit_normal() (length), 2x2 sympy Matrix.
 
         Positive on a sphere / ellipsoid: a sphere of radius r has II = I / r.
         """
-        return self._get("second_fundamental_form", self._c_second_fundamental_form)
+        return self._get("second_fundamental_form", self.derive_second_fundamental_form)
 
     def shape_operator(self):
         """S = I^-1 II (1/length), acting on coordinate vectors (du, dv); eigenvalues k1, k2."""
-        return self._get("shape_operator", self._c_shape_operator)
+        return self._get("shape_operator", self.derive_shape_operator)
 
     def area_element(self):
         """sqrt(EG - F^2) = |p_u x p_v| (length^2 per unit parameter area)."""
-        return self._get("area_element", self._c_area_element)
+        return self._get("area_element", self.derive_area_element)
 
     def gaussian_curvature(self):
         """K = (eg - f^2) / (EG - F^2) = k1 k2, pointwise, 1/length^2 (1/r^2 on a sphere)."""
-        return self._get("gaussian_curvature", self._c_gaussian_curvature)
+        return self._get("gaussian_curvature", self.derive_gaussian_curvature)
 
     def mean_curvature(self):
         """H = (eG - 2fF + gE) / (2 (EG - F^2)) = (k1 + k2)/2, pointwise, 1/length (+1/r on a sphere)."""
-        return self._get("mean_curvature", self._c_mean_curvature)
+        return self._get("mean_curvature", self.derive_mean_curvature)
 
     def frame_coefficients(self):
         """(A, B, C) with kappa_n(phi) = A cos^2 phi + 2 B sin phi cos phi + C sin^2 phi (1/length).
@@ -444,7 +446,7 @@ class ParametricSurface:
         A = kappa_n(0) (direction p_u), C = kappa_n(pi/2), B the twist; the
         second fundamental form written in the orthonormal frame (p_u/|p_u|, w).
         """
-        return self._get("frame_coefficients", self._c_frame_coefficients)
+        return self._get("frame_coefficients", self.derive_frame_coefficients)
 
     def _at(self, expr, u, v):
         """expr (this surface's, or a tuple/matrix of them) at (u, v), simplified."""
@@ -460,7 +462,7 @@ class ParametricSurface:
     def _point(self, key, u, v):
         """A cached family result at (u, v) with this surface's values, substituted once."""
         if u is None and v is None:
-            return self._get(key, getattr(self, "_c_" + key))
+            return self._get(key, getattr(self, "derive_" + key))
         ckey = ("at", key, sp.sympify(u) if u is not None else None, sp.sympify(v) if v is not None else None)
         if ckey not in self._cache:
             src = self._family or self
@@ -469,7 +471,7 @@ class ParametricSurface:
                 sub[self.u] = sp.sympify(u)
             if v is not None:
                 sub[self.v] = sp.sympify(v)
-            self._cache[ckey] = _subs_tidy(src._get(key, getattr(src, "_c_" + key)), sub)
+            self._cache[ckey] = _subs_tidy(src._get(key, getattr(src, "derive_" + key)), sub)
         return self._cache[ckey]
 
     def normal_curvature(self, phi, u=None, v=None):
@@ -495,7 +497,7 @@ class ParametricSurface:
         H = (A + C)/2, sqrt(H^2 - K) = sqrt(((A - C)/2)^2 + B^2).
         """
         if u is None and v is None:
-            return self._get("principal_curvatures", self._c_principal_curvatures)
+            return self._get("principal_curvatures", self.derive_principal_curvatures)
         A, B, C = self._point("frame_coefficients", u, v)
         H = _tidy((A + C) / 2)
         R = _tidy(sp.sqrt(((A - C) / 2) ** 2 + B**2))
