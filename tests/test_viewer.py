@@ -220,6 +220,9 @@ def test_still_puts_the_mesh_in_the_middle():
     colors2 = np.vstack([colors, np.tile([0.0, 0.0, 1.0], (4, 1))])
     image2 = render_still(V2, F2, colors2, width=100, height=80)
     assert image2[40, 50, 2] > 200 and image2[40, 50, 0] < 40
+    # whatever the order of the faces
+    image3 = render_still(V2, F2[::-1], colors2, width=100, height=80)
+    assert (image3 == image2).all()
 
 
 def test_plain_view_without_values(sphere):

@@ -297,6 +297,9 @@ nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-to
 p.site-kernel-note { font-style: italic; color: #555; margin: 0.2em 0; }
 details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 13px;
   font-family: var(--jp-ui-font-family); margin: 0.3em 0 0.3em 6em; }
+/* the widget style sheets take their font from a variable only JupyterLab's own page defines */
+.jupyter-widgets, .jupyter-widgets input, .jupyter-widgets select, .jupyter-widgets button {
+  font-family: var(--jp-ui-font-family); }
 </style>
 {%- endblock html_head_js_requirejs -%}
 {%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}

@@ -15,7 +15,8 @@ On every page:
    (without WebGL, the still pictures are shown instead: a separate test);
 4. the formulas are typeset by the MathJax served from the site: MathJax
    output is present, no TeX error, no ``$$`` left in the text;
-5. every control that needs a kernel is disabled, and a note says so;
+5. every control that needs a kernel is disabled, and a note says so; widget labels use
+   JupyterLab's interface font (not the browser's default serif);
 6. no console error and no uncaught exception;
 7. no cell raised an error while the notebook ran for the site.
 
@@ -131,15 +132,20 @@ JS_MATH = """
 }
 """
 
-JS_CONTROLS = """
+JS_CONTROLS = r"""
 () => {
   const sliders = Array.from(document.querySelectorAll('.widget-slider, .widget-dropdown, .widget-toggle-buttons, .widget-checkbox, .widget-button'));
   const enabled = sliders.filter(el => {
     const inputs = el.querySelectorAll('input, select, button, .noUi-target, .slider');
     return Array.from(inputs).some(i => !(i.disabled || i.hasAttribute('disabled')));
   });
+  const bare = s => s.replace(/["'\s]/g, '');  // the same list of families, however quoted
+  const ui = bare(getComputedStyle(document.body).getPropertyValue('--jp-ui-font-family'));
+  const labels = Array.from(document.querySelectorAll('.widget-label, .widget-readout, .widget-html-content'));
+  const fonts = new Set(labels.map(el => bare(getComputedStyle(el).fontFamily)));
   return {controls: sliders.length, enabled: enabled.length,
-          notes: document.querySelectorAll('.site-kernel-note').length};
+          notes: document.querySelectorAll('.site-kernel-note').length,
+          ui: ui, fonts: Array.from(fonts), labels: labels.length};
 }
 """
 
@@ -212,6 +218,9 @@ def test_page_offline(notebook, site, site_url, browser):
         assert controls["enabled"] == 0, f"{controls['enabled']} controls look usable without a kernel"
         if controls["controls"]:
             assert controls["notes"] > 0, "controls are shown without the note that they need JupyterLab"
+        if controls["labels"]:  # widget text in JupyterLab's interface font, as in the workbook itself
+            assert controls["ui"], "the page does not define JupyterLab's --jp-ui-font-family"
+            assert controls["fonts"] == [controls["ui"]], f"widget labels in {controls['fonts']}, not {controls['ui']}"
         page.screenshot(path=str(shots / "page.png"))
         assert not view.outside, f"requests to the network: {view.outside}"
         assert not view.missing, f"files missing from the site: {view.missing}"
