@@ -349,6 +349,12 @@ def changed_fraction(png_a, png_b):
     return float(np.any(np.abs(a - b) > 8, axis=2).mean())
 
 
+def find_slider(page, timeout):
+    """JS_FIND_SLIDER's answer, waited for: widget views attach to the page asynchronously,
+    after their cell has reported that it ran, so a slider may come a moment after its view."""
+    return wait_for(lambda: (found := page.evaluate(JS_FIND_SLIDER))["found"] and found, timeout) or {"found": False}
+
+
 def wait_for(predicate, timeout, interval=0.3):
     """Call ``predicate`` until it returns something true or ``timeout`` seconds pass; return its last value."""
     deadline = time.monotonic() + timeout

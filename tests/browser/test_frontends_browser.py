@@ -150,7 +150,7 @@ def test_notebook_in_notebook7(notebook, browser, notebook7_server):
             (screenshot_dir / f"canvas{i}.png").write_bytes(shot["png"])
             assert ok, f"view {i} of {notebook} is blank in Notebook 7"
 
-        found = page.evaluate(lablib.JS_FIND_SLIDER)
+        found = lablib.find_slider(page, RENDER_TIMEOUT)
         assert found["found"], f"{notebook}: no slider beside a view"
         box_canvases = page.locator("[data-geomlib-box] .geomlib-canvas")
         before = [lablib.stable_screenshot(box_canvases.nth(i)) for i in range(box_canvases.count())]

@@ -79,7 +79,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             )
 
         # 4: a slider beside a view changes the picture
-        found = page.evaluate(lablib.JS_FIND_SLIDER)
+        found = lablib.find_slider(page, RENDER_TIMEOUT)
         assert found["found"], (
             f"{notebook}: no slider shares an ipywidgets box or a cell with a view; put them in one box, "
             "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/viewer.py)"
