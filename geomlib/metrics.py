@@ -135,9 +135,8 @@ def dihedral_angles(V, F, edges=None):
     return E, _bend_angles(V, F, E, f1, f2)
 
 
-def _bend_angles(V, F, E, f1, f2, N=None):
-    N = face_cross(V, F) if N is None else N
-    n1, n2 = N[f1], N[f2]
+def _bend_angles(V, F, E, f1, f2):
+    n1, n2 = face_cross(V, F[f1]), face_cross(V, F[f2])  # only the faces at these edges
     angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), np.einsum("ij,ij->i", n1, n2)))
     # far vertex of f2: the corner that is neither end of the edge
     G = F[f2]
@@ -320,7 +319,9 @@ class MeshComparison:
     """One clean mesh ``(V_clean, F)`` to compare meshes of the same connectivity against.
 
     Holds the clean mesh, its properties and the metric settings; every
-    method calls the function of the same name (one implementation each).
+    method shares its formula with the function of the same name, and the
+    clean mesh's side of it (face normals, area, volume, bend angles) is
+    computed once, here.
 
     Parameters
     ----------
@@ -367,6 +368,10 @@ class MeshComparison:
         self.edges, self.bend_clean = dihedral_angles(self.V_clean, self.F, self._interior)
         self.sharp = np.flatnonzero(np.abs(self.bend_clean) > self.sharp_angle)
         self._sharp_edges = tuple(x[self.sharp] for x in self._interior[:3])
+        # the clean side of every metric, computed once (evaluate runs thousands of times in a sweep)
+        self._N_clean = face_cross(self.V_clean, self.F)
+        self._area_clean = surface_area(self.V_clean, self.F)
+        self._volume_clean = enclosed_volume(self.V_clean, self.F) if self.closed else None
 
     def _check(self, V):
         V = as_vertices(V)
@@ -379,11 +384,13 @@ class MeshComparison:
 
     def face_normal_angles(self, V):
         """:func:`face_normal_angles` against the clean mesh, (m,) degrees."""
-        return face_normal_angles(self._check(V), self.V_clean, self.F)
+        return _normal_angles(face_cross(self._check(V), self.F), self._N_clean)
 
     def sharp_edge_error(self, V):
         """:func:`sharp_edge_error` with this comparison's ``sharp_angle``; NaN without sharp edges."""
-        return sharp_edge_error(self._check(V), self.V_clean, self.F, self.sharp_angle, self._sharp_edges)
+        if not len(self.sharp):
+            return float("nan")
+        return _bend_error(self._check(V), self.F, *self._sharp_edges, self.bend_clean[self.sharp])
 
     def hausdorff(self, V, relative=True, seed=None):
         """:func:`hausdorff_distance` to the clean surface, with this comparison's density and seed."""
@@ -398,11 +405,13 @@ class MeshComparison:
 
     def area_change(self, V):
         """:func:`area_change`: ``(A - A_clean) / A_clean``."""
-        return area_change(self._check(V), self.V_clean, self.F)
+        return _area_change(surface_area(self._check(V), self.F), self._area_clean)
 
     def volume_change(self, V):
         """:func:`volume_change`: ``(vol - vol_clean) / |vol_clean|``; MeshError on an open mesh."""
-        return volume_change(self._check(V), self.V_clean, self.F, self._interior)
+        if not self.closed:
+            return volume_change(self._check(V), self.V_clean, self.F, self._interior)  # raises, naming the edges
+        return _volume_change(enclosed_volume(self._check(V), self.F), self._volume_clean)
 
     def evaluate(self, V, hausdorff=True):
         """All metrics of V against the clean mesh, as a dict.
@@ -418,7 +427,7 @@ class MeshComparison:
         out = {"rms": self.vertex_rms(V)}
         if hausdorff:
             out["hausdorff"] = self.hausdorff(V)
-        out["normal_mean"], out["normal_p95"] = normal_angle_error(V, self.V_clean, self.F)
+        out["normal_mean"], out["normal_p95"] = _mean_and_p95(self.face_normal_angles(V))
         out["area_change"] = self.area_change(V)
         out["volume_change"] = self.volume_change(V) if self.closed else float("nan")
         out["sharp_edge_error"] = self.sharp_edge_error(V)
@@ -520,14 +529,19 @@ def normal_angle_error(V, V_clean, F):
     The mean and the 95th percentile (linear interpolation) over faces of
     :func:`face_normal_angles` (unweighted: every face counts once).
     """
-    angles = face_normal_angles(V, V_clean, F)
+    return _mean_and_p95(face_normal_angles(V, V_clean, F))
+
+
+def _mean_and_p95(angles):
     return float(angles.mean()), float(np.percentile(angles, 95))
 
 
 def area_change(V, V_clean, F):
     """Signed relative change of the surface area, ``(A - A_clean) / A_clean``."""
-    A = surface_area(V, F)
-    A_clean = surface_area(V_clean, F)
+    return _area_change(surface_area(V, F), surface_area(V_clean, F))
+
+
+def _area_change(A, A_clean):
     if not A_clean > 0:
         raise MeshError("the clean mesh has zero area")
     return A / A_clean - 1.0
@@ -551,10 +565,13 @@ def volume_change(V, V_clean, F, edges=None):
             "the volume change is defined for closed meshes only; "
             f"{len(bad)} edge(s) are boundary or non-manifold, e.g. " + ", ".join(f"({i}, {j})" for i, j in bad[:5])
         )
-    vol_clean = enclosed_volume(V_clean, F)
+    return _volume_change(enclosed_volume(V, F), enclosed_volume(V_clean, F))
+
+
+def _volume_change(vol, vol_clean):
     if vol_clean == 0:
         raise MeshError("the clean mesh encloses zero volume")
-    return (enclosed_volume(V, F) - vol_clean) / abs(vol_clean)
+    return (vol - vol_clean) / abs(vol_clean)
 
 
 def sharp_edges(V_clean, F, threshold=SHARP_ANGLE):
@@ -588,8 +605,12 @@ def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE, edges=None):
     sharp = np.abs(bend_clean) > threshold
     if not sharp.any():
         return float("nan")
-    bend = _bend_angles(V, F, E[sharp], f1[sharp], f2[sharp])
-    return float(np.mean(np.abs(bend - bend_clean[sharp])))
+    return _bend_error(V, F, E[sharp], f1[sharp], f2[sharp], bend_clean[sharp])
+
+
+def _bend_error(V, F, E, f1, f2, bend_clean):
+    """Mean |theta(V) - theta_clean| (degrees) over the edges E with faces f1, f2."""
+    return float(np.mean(np.abs(_bend_angles(V, F, E, f1, f2) - bend_clean)))
 
 
 def denoising_metrics(V, V_clean, F, sharp_angle=SHARP_ANGLE, samples_per_face=HAUSDORFF_SAMPLES_PER_FACE, seed=0):

@@ -340,6 +340,22 @@ def test_smoothing_a_cube_rounds_its_sharp_edges():
     assert sharp_edge_error(W, V, F) > 10.0
 
 
+def test_every_method_of_the_comparison_gives_its_function():
+    """The class keeps the clean side computed once; the numbers are the functions' own."""
+    mesh = trimesh.creation.box(extents=(2.0, 1.0, 0.5)).subdivide().subdivide()
+    V, F = np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
+    W = add_noise(V, F, 0.01, seed=4)
+    cmp = MeshComparison(V, F)
+    assert len(cmp.sharp) > 0 and cmp.closed
+    np.testing.assert_array_equal(cmp.face_normal_angles(W), face_normal_angles(W, V, F))
+    assert cmp.area_change(W) == area_change(W, V, F)
+    assert cmp.volume_change(W) == volume_change(W, V, F)
+    assert cmp.sharp_edge_error(W) == sharp_edge_error(W, V, F)
+    values = cmp.evaluate(W, hausdorff=False)
+    assert (values["normal_mean"], values["normal_p95"]) == normal_angle_error(W, V, F)
+    assert values["sharp_edge_error"] > 0 and values["area_change"] > 0
+
+
 # --- bad input ---------------------------------------------------------------
 
 
