@@ -665,6 +665,15 @@ def sphere(r=1.0, subdivisions=3, jitter=0.0, seed=0):
     )
 
 
+def _ellipsoid_mesh(params, V, F, uv):
+    """The closed ellipsoid mesh (icosphere or UV-grid built) with its exact values, area and volume."""
+    a, b, c = params["a"], params["b"], params["c"]
+    truth = _symbolic_truth("ellipsoid", (a, b, c), uv)
+    return _make(
+        "ellipsoid", params, V, F, uv, True, truth, area=_ellipsoid_area(a, b, c), volume=4 / 3 * np.pi * a * b * c
+    )
+
+
 def ellipsoid(a=1.0, b=0.7, c=0.5, subdivisions=3, jitter=0.0, seed=0):
     """Ellipsoid x^2/a^2 + y^2/b^2 + z^2/c^2 = 1 from a mapped icosphere.
 
@@ -699,18 +708,7 @@ def ellipsoid(a=1.0, b=0.7, c=0.5, subdivisions=3, jitter=0.0, seed=0):
     V = P * np.array([a, b, c])
     _check_faces(V, F, V / np.array([a * a, b * b, c * c]), "ellipsoid")  # gradient side = outside
     params = dict(a=a, b=b, c=c, subdivisions=subdivisions, jitter=jitter, seed=seed)
-    uv = _ellipsoid_uv(V, a, b, c)
-    return _make(
-        "ellipsoid",
-        params,
-        V,
-        F,
-        uv,
-        True,
-        _symbolic_truth("ellipsoid", (a, b, c), uv),
-        area=_ellipsoid_area(a, b, c),
-        volume=4.0 / 3.0 * np.pi * a * b * c,
-    )
+    return _ellipsoid_mesh(params, V, F, _ellipsoid_uv(V, a, b, c))
 
 
 def _uv_ellipsoid_mesh(a, b, c, n, jitter, seed):
@@ -764,17 +762,7 @@ def uv_ellipsoid(a=1.0, b=0.7, c=0.5, n=16, jitter=0.0, seed=0):
     V, F, uv = _uv_ellipsoid_mesh(a, b, c, n, jitter, seed)
     _check_faces(V, F, V / np.array([a * a, b * b, c * c]), "uv_ellipsoid")
     params = dict(a=a, b=b, c=c, n=n, jitter=jitter, seed=seed)
-    return _make(
-        "ellipsoid",
-        params,
-        V,
-        F,
-        uv,
-        True,
-        _symbolic_truth("ellipsoid", (a, b, c), uv),
-        area=_ellipsoid_area(a, b, c),
-        volume=4.0 / 3.0 * np.pi * a * b * c,
-    )
+    return _ellipsoid_mesh(params, V, F, uv)
 
 
 def uv_sphere(r=1.0, n=16, jitter=0.0, seed=0):
