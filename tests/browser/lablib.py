@@ -355,6 +355,20 @@ def find_slider(page, timeout):
     return wait_for(lambda: (found := page.evaluate(JS_FIND_SLIDER))["found"] and found, timeout) or {"found": False}
 
 
+def views(page, timeout):
+    """The page's 3D views (``.geomlib-canvas``), once at least one is there and their
+    number held still for a moment: like sliders, views attach after their cell ran."""
+    canvases = page.locator(".geomlib-canvas")
+    seen = []
+
+    def settled():
+        seen.append(canvases.count())
+        return len(seen) > 1 and seen[-1] >= 1 and seen[-1] == seen[-2]
+
+    wait_for(settled, timeout, interval=0.5)
+    return canvases
+
+
 def wait_for(predicate, timeout, interval=0.3):
     """Call ``predicate`` until it returns something true or ``timeout`` seconds pass; return its last value."""
     deadline = time.monotonic() + timeout

@@ -137,7 +137,7 @@ def test_notebook_in_notebook7(notebook, browser, notebook7_server):
         )
         assert state["done"] == state["code"]
 
-        canvases = page.locator(".geomlib-canvas")
+        canvases = lablib.views(page, RENDER_TIMEOUT)
         assert canvases.count() >= 1, f"{notebook} shows no view in Notebook 7"
         for i in range(canvases.count()):
             shot = {}

@@ -59,7 +59,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         assert state["done"] == state["code"], f"only {state['done']} of {state['code']} code cells ran"
 
         # 3: every view shows a picture
-        canvases = page.locator(".geomlib-canvas")
+        canvases = lablib.views(page, RENDER_TIMEOUT)
         count = canvases.count()
         assert count >= 1, f"{notebook} shows no MeshView (.geomlib-canvas)"
         for i in range(count):
