@@ -63,6 +63,7 @@ _EXPORTS = {
     "explicit_step_limit": "smoothing",
     "highest_frequency_mode": "smoothing",
     "fixed_point": "smoothing",
+    "ExplicitSmoother": "smoothing",
     "ImplicitSmoother": "smoothing",
     # noise and evaluation
     "add_noise": "noise",

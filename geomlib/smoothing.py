@@ -56,6 +56,7 @@ __all__ = [
     "explicit_step_limit",
     "highest_frequency_mode",
     "fixed_point",
+    "ExplicitSmoother",
     "ImplicitSmoother",
 ]
 
@@ -254,39 +255,16 @@ def _moving(F, n, boundary):
     return moving
 
 
-def _fail(on_failure, message, k, P_last):
-    """Raise MeshError or warn and return the last valid positions."""
+def _fail(on_failure, message, k, P_last, stacklevel=3):
+    """Raise MeshError or warn (naming the frame ``stacklevel`` up) and return the last valid positions."""
     if on_failure == "raise":
         err = MeshError(message + "; the last valid positions are in the error's .V")
         err.V, err.iteration = P_last, k - 1
         raise err
-    warnings.warn(message + f"; stopped and returned the positions after iteration {k - 1}", MeshWarning, stacklevel=3)
+    warnings.warn(
+        message + f"; stopped and returned the positions after iteration {k - 1}", MeshWarning, stacklevel=stacklevel
+    )
     return P_last
-
-
-def _explicit_tau(V, F, M, C, step, step_fraction, weights, area, boundary, moving):
-    """The step from ``step`` or ``step_fraction``; warns (once) when it exceeds the limit."""
-    if (step is None) == (step_fraction is None):
-        raise MeshError("give exactly one of step and step_fraction")
-    if step_fraction is not None:
-        limit = explicit_step_limit(V, F, weights, area, boundary)
-        return _check_step(step_fraction, "step_fraction") * limit if np.isfinite(limit) else 0.0
-    tau = _check_step(step)
-    # Gershgorin: lam_max <= max 2 |C_ii| / M_ii, so steps below 2 / that bound are
-    # certainly stable and need no eigenvalue computation.
-    m, c = M.diagonal()[moving], np.abs(C.diagonal()[moving])
-    if tau > 0 and moving.any() and tau * np.max(2.0 * c / m) > 2.0:
-        limit = explicit_step_limit(V, F, weights, area, boundary)
-        if tau > limit * (1 + 1e-12):
-            warnings.warn(
-                f"explicit step {tau:.6g} exceeds the stability limit {limit:.6g} "
-                f"(= 2 / lambda_max, {weights} weights, boundary {boundary}): the "
-                f"highest-frequency component grows by {abs(1 - 2 * tau / limit):.4g} "
-                f"per iteration",
-                MeshWarning,
-                stacklevel=3,
-            )
-    return tau
 
 
 # --------------------------------------------------------------------------
@@ -356,39 +334,95 @@ def explicit_smoothing(
 
     References: Taubin 1995; Desbrun, Meyer, Schroeder and Barr 1999.
     """
-    V, F = as_mesh(V, F)
-    iterations = _check_iterations(iterations)
-    for value, name, choices in (
-        (weights, "weights", _WEIGHTS),
-        (boundary, "boundary", _BOUNDARY),
-        (on_failure, "on_failure", _ON_FAILURE),
-    ):
-        _check_choice(value, name, choices)
-    M, C = laplacian(V, F, weights=weights, area=area)
-    m = positive_vertex_areas(M, F, "explicit_smoothing")
-    moving = _moving(F, len(V), boundary)
-    tau = _explicit_tau(V, F, M, C, step, step_fraction, weights, area, boundary, moving)
-    tau_Minv_C = sp.diags(np.where(moving, tau / m, 0.0)) @ C  # tau M^-1 C, zero rows where fixed
-    far = BLOWUP_FACTOR * max(bounding_box_diagonal(V), np.finfo(float).tiny)
-    P, bar = V.copy(), Iterations(iterations, progress, "explicit smoothing")
-    try:
-        for k in range(1, iterations + 1):
-            P_next = P + tau_Minv_C @ P  # P + tau M^-1 C P
-            if not np.isfinite(P_next).all() or np.abs(P_next - V).max() > far:
-                return _fail(
-                    on_failure,
-                    f"explicit smoothing diverged at iteration {k} (step "
-                    f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals",
-                    k,
-                    P,
+    # _smooth, not smooth: the warnings then name the caller of explicit_smoothing
+    return ExplicitSmoother(V, F, weights, area, boundary)._smooth(
+        step, iterations, step_fraction, progress, callback, on_failure
+    )
+
+
+class ExplicitSmoother:
+    """Explicit smoothing with the operator of V kept fixed: ``M`` and ``C`` assembled once, stepped many times.
+
+    :func:`explicit_smoothing` in two parts, for a slider or a sweep that
+    smooths one mesh with many steps and iteration counts: the constructor
+    assembles the Laplacian of V (at 200k vertices as long as some 50 steps),
+    and every :meth:`smooth` runs from V with its own step.
+
+    Parameters
+    ----------
+    V, F, weights, area, boundary : as in :func:`explicit_smoothing`.
+
+    Raises
+    ------
+    MeshError
+        Bad mesh or option; vertices with zero area (named).
+    """
+
+    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed"):
+        V, F = as_mesh(V, F)
+        _check_choice(weights, "weights", _WEIGHTS)
+        _check_choice(boundary, "boundary", _BOUNDARY)
+        self.V, self.F = V, F
+        self.weights, self.area, self.boundary = weights, area, boundary
+        self.M, self.C = laplacian(V, F, weights=weights, area=area)
+        self.m = positive_vertex_areas(self.M, F, "explicit_smoothing")
+        self.moving = _moving(F, len(V), boundary)
+
+    def smooth(self, step=None, iterations=1, *, step_fraction=None, progress=None, callback=None, on_failure="raise"):
+        """Run ``iterations`` explicit steps from V; arguments, result, errors and warnings as in
+        :func:`explicit_smoothing`. Returns a new (n, 3) array."""
+        return self._smooth(step, iterations, step_fraction, progress, callback, on_failure)
+
+    def _smooth(self, step, iterations, step_fraction, progress, callback, on_failure):
+        # reached from smooth and from explicit_smoothing alike, so that the warnings of _tau and
+        # _fail (stacklevel 4) name the reader's line that called either
+        iterations = _check_iterations(iterations)
+        _check_choice(on_failure, "on_failure", _ON_FAILURE)
+        tau = self._tau(step, step_fraction)
+        tau_Minv_C = sp.diags(np.where(self.moving, tau / self.m, 0.0)) @ self.C  # tau M^-1 C, zero rows where fixed
+        far = BLOWUP_FACTOR * max(bounding_box_diagonal(self.V), np.finfo(float).tiny)
+        P, bar = self.V.copy(), Iterations(iterations, progress, "explicit smoothing")
+        try:
+            for k in range(1, iterations + 1):
+                P_next = P + tau_Minv_C @ P  # P + tau M^-1 C P
+                if not np.isfinite(P_next).all() or np.abs(P_next - self.V).max() > far:
+                    message = (
+                        f"explicit smoothing diverged at iteration {k} (step "
+                        f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals"
+                    )
+                    return _fail(on_failure, message, k, P, stacklevel=4)
+                P = P_next
+                if callback is not None:
+                    callback(k, P)
+                bar.step(k)
+        finally:
+            bar.close()
+        return P
+
+    def _tau(self, step, step_fraction):
+        """The step from ``step`` or ``step_fraction``; warns when it exceeds the limit."""
+        if (step is None) == (step_fraction is None):
+            raise MeshError("give exactly one of step and step_fraction")
+        limit_args = (self.V, self.F, self.weights, self.area, self.boundary)
+        if step_fraction is not None:
+            limit = explicit_step_limit(*limit_args)
+            return _check_step(step_fraction, "step_fraction") * limit if np.isfinite(limit) else 0.0
+        tau = _check_step(step)
+        # Gershgorin: lam_max <= max 2 |C_ii| / M_ii, so steps below 2 / that bound are
+        # certainly stable and need no eigenvalue computation.
+        m, c = self.m[self.moving], np.abs(self.C.diagonal()[self.moving])
+        if tau > 0 and self.moving.any() and tau * np.max(2.0 * c / m) > 2.0:
+            limit = explicit_step_limit(*limit_args)
+            if tau > limit * (1 + 1e-12):
+                warnings.warn(
+                    f"explicit step {tau:.6g} exceeds the stability limit {limit:.6g} "
+                    f"(= 2 / lambda_max, {self.weights} weights, boundary {self.boundary}): the "
+                    f"highest-frequency component grows by {abs(1 - 2 * tau / limit):.4g} "
+                    f"per iteration",
+                    MeshWarning,
+                    stacklevel=4,
                 )
-            P = P_next
-            if callback is not None:
-                callback(k, P)
-            bar.step(k)
-    finally:
-        bar.close()
-    return P
+        return tau
 
 
 # --------------------------------------------------------------------------

@@ -16,7 +16,7 @@ from .errors import MeshError, MeshWarning
 from .geometry import mean_edge_length
 from .metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
 from .noise import add_noise
-from .smoothing import ImplicitSmoother, explicit_smoothing, explicit_step_limit
+from .smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit
 
 __all__ = [
     "SCHEMES",
@@ -169,11 +169,12 @@ def smoothing_sweep(
     and the mesh is measured against the clean one after each count in
     ``iterations`` (:meth:`MeshComparison.evaluate` without the Hausdorff
     estimate). One run per (noise level, scheme, step) covers all iteration
-    counts; implicit runs factorise ``M - step C`` once per (noisy mesh,
-    weights, step) and reuse it (:class:`geomlib.smoothing.ImplicitSmoother`).
-    The operators are those of the noisy mesh, built once per run and kept
-    fixed (as in :func:`geomlib.explicit_smoothing` and
-    :func:`geomlib.implicit_smoothing`).
+    counts. The operators are those of the noisy mesh, assembled once per
+    (noisy mesh, weights) and kept fixed, as in
+    :func:`geomlib.explicit_smoothing` and :func:`geomlib.implicit_smoothing`
+    (:class:`geomlib.smoothing.ExplicitSmoother`,
+    :class:`geomlib.smoothing.ImplicitSmoother`); implicit runs factorise
+    ``M - step C`` once per step.
 
     Parameters
     ----------
@@ -224,7 +225,7 @@ def smoothing_sweep(
             for key, value in C.evaluate(Vn, hausdorff=False).items():
                 out.noisy[key][i] = value
             for j, (method, weights) in enumerate(schemes):
-                smoother = ImplicitSmoother(Vn, C.F, weights) if method == "implicit" else None
+                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
                 for k, value in enumerate(step_values[method]):
                     step = scale_free_step(Vn, C.F, method, weights, value)
                     out.steps[i, j, k] = step
@@ -237,9 +238,7 @@ def smoothing_sweep(
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore", MeshWarning)
                         if method == "explicit":
-                            explicit_smoothing(
-                                Vn, C.F, step, last, weights, callback=record, on_failure="stop", progress=False
-                            )
+                            smoother.smooth(step, last, callback=record, on_failure="stop", progress=False)
                         else:
                             smoother.smooth(step, last, callback=record, progress=False)
                     if bar is not None:

@@ -11,6 +11,7 @@ from meshdata import COURSE
 
 from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_limit, implicit_smoothing, laplacian
 from geomlib.smoothing import (
+    ExplicitSmoother,
     ImplicitSmoother,
     _volume_centroid,
     explicit_step,
@@ -415,6 +416,37 @@ def test_step_past_limit_warns_once_naming_the_limit():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         explicit_smoothing(V, F, 0.999 * limit, 3)  # no warning below the limit
+
+
+def test_explicit_smoother_gives_explicit_smoothing_for_every_step_from_one_operator():
+    V, F = grid(9, jitter=0.2)
+    smoother = ExplicitSmoother(V, F)
+    limit = explicit_step_limit(V, F)
+    for step, iterations in ((0.3 * limit, 5), (0.9 * limit, 12), (0.0, 3), (0.5 * limit, 0)):
+        np.testing.assert_array_equal(smoother.smooth(step, iterations), explicit_smoothing(V, F, step, iterations))
+    np.testing.assert_array_equal(
+        smoother.smooth(step_fraction=0.7, iterations=4), explicit_smoothing(V, F, step_fraction=0.7, iterations=4)
+    )
+    assert np.abs(smoother.smooth(0.9 * limit, 12) - V).max() > 0  # it moved, from V every time
+    np.testing.assert_array_equal(
+        smoother.smooth(0.9 * limit, 12)[_boundary_mask(F, len(V))], V[_boundary_mask(F, len(V))]
+    )
+
+
+def test_explicit_warnings_name_the_readers_line_through_either_door():
+    V, F = icosphere(1)
+    limit = explicit_step_limit(V, F)
+    smoother = ExplicitSmoother(V, F)
+    for run in (
+        lambda: explicit_smoothing(V, F, 1.5 * limit, 3),
+        lambda: smoother.smooth(1.5 * limit, 3),
+        lambda: explicit_smoothing(V, F, 3 * limit, 500, on_failure="stop"),
+        lambda: smoother.smooth(3 * limit, 500, on_failure="stop"),
+    ):
+        with warnings.catch_warnings(record=True) as record:
+            warnings.simplefilter("always")
+            run()
+        assert record and {w.filename for w in record} == {__file__}, [(w.filename, str(w.message)) for w in record]
 
 
 def test_progress_bar_options_do_not_change_results(capsys):
