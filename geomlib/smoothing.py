@@ -345,7 +345,7 @@ class ExplicitSmoother:
 
     :func:`explicit_smoothing` in two parts, for a slider or a sweep that
     smooths one mesh with many steps and iteration counts: the constructor
-    assembles the Laplacian of V (at 200k vertices as long as some 50 steps),
+    assembles the Laplacian of V (at 164k vertices as long as about 30 steps),
     and every :meth:`smooth` runs from V with its own step.
 
     Parameters
