@@ -364,8 +364,8 @@ class ExplicitSmoother:
         _check_choice(boundary, "boundary", _BOUNDARY)
         self.V, self.F = V, F
         self.weights, self.area, self.boundary = weights, area, boundary
-        self.M, self.C = laplacian(V, F, weights=weights, area=area)
-        self.m = positive_vertex_areas(self.M, F, "explicit_smoothing")
+        M, self.C = laplacian(V, F, weights=weights, area=area)
+        self.m = positive_vertex_areas(M, F, "explicit_smoothing")  # the diagonal of M
         self.moving = _moving(F, len(V), boundary)
 
     def smooth(self, step=None, iterations=1, *, step_fraction=None, progress=None, callback=None, on_failure="raise"):
