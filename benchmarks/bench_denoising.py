@@ -29,9 +29,9 @@ import numpy as np
 import trimesh
 
 import geomlib
-from geomlib.errors import MeshWarning
-from geomlib.metrics import MeshComparison, denoising_metrics, point_surface_distance, sample_surface
-from geomlib.sweep import (
+from geomlib.lessons.metrics import MeshComparison, denoising_metrics, point_surface_distance, sample_surface
+from geomlib.mesh.errors import MeshWarning
+from geomlib.teaching.sweep import (
     EXPLICIT_FRACTIONS,
     IMPLICIT_STEPS,
     SCHEMES,

@@ -43,8 +43,8 @@ OPS = ("cotan+M", "cotan+Mmixed", "K", "K-deficit")
 
 
 def ours(op):
-    from geomlib.curvature import gaussian_curvature
-    from geomlib.laplace import laplacian
+    from geomlib.lessons.curvature import gaussian_curvature
+    from geomlib.lessons.laplace import laplacian
 
     return {
         "cotan+M": lambda V, F: laplacian(V, F, "cotan", "barycentric"),
@@ -138,7 +138,7 @@ def main():
 
     import platform
 
-    from geomlib.surfaces import icosphere
+    from geomlib.teaching.surfaces import icosphere
 
     results = []
 

@@ -17,7 +17,7 @@ Each notebook then runs top to bottom in a fresh kernel, with every mesh
 parameter pointing at these files and every other parameter at its default, and
 with an empty eigenbasis cache. For each notebook the script prints the wall
 time against the budget of the issue (180 s on 2 cores), the slowest cells, and
-each cell over ``geomlib.progress.SECONDS`` that showed no progress bar.
+each cell over ``geomlib.numerics.progress.SECONDS`` that showed no progress bar.
 """
 
 import argparse
@@ -36,7 +36,7 @@ import make_meshes  # noqa: E402
 from notebook_runner import run_notebook  # noqa: E402
 
 import geomlib  # noqa: E402
-from geomlib import progress  # noqa: E402
+from geomlib.numerics import progress  # noqa: E402
 
 BUDGET = 180.0
 NOISE = 0.17  # mean edge lengths: the noise of the shipped cad_part_noisy.obj against cad_part.obj
@@ -44,7 +44,7 @@ NOISE = 0.17  # mean edge lengths: the noise of the shipped cad_part_noisy.obj a
 
 def refined(V, F, n):
     """(V, F) with every edge split until the mesh has at least n vertices."""
-    ell = geomlib.geometry.mean_edge_length(V, F)
+    ell = geomlib.mesh.geometry.mean_edge_length(V, F)
     lo, hi = 0.05, 1.0  # max edge as a fraction of the mean edge length
     for _ in range(12):
         mid = 0.5 * (lo + hi)
@@ -55,7 +55,7 @@ def refined(V, F, n):
 
 def noisy(V, F, seed):
     """V with Gaussian noise of NOISE mean edge lengths (standard deviation per coordinate)."""
-    sigma = NOISE * geomlib.geometry.mean_edge_length(V, F) / geomlib.geometry.bounding_box_diagonal(V)
+    sigma = NOISE * geomlib.mesh.geometry.mean_edge_length(V, F) / geomlib.mesh.geometry.bounding_box_diagonal(V)
     return geomlib.add_noise(V, F, sigma, seed=seed)
 
 
@@ -64,7 +64,7 @@ def build_meshes(folder, n):
     V, F = refined(V, F, n)
     geomlib.save_mesh(folder / "scan.obj", V, F)
     geomlib.save_mesh(folder / "scan_noisy.obj", noisy(V, F, seed=1), F)
-    grid = geomlib.surfaces.plane(n=int(np.ceil(np.sqrt(n))), size=2.0)
+    grid = geomlib.teaching.surfaces.plane(n=int(np.ceil(np.sqrt(n))), size=2.0)
     geomlib.save_mesh(folder / "plane_noisy.obj", noisy(grid.V, grid.F, seed=2), grid.F)
     shipped = len(geomlib.load_mesh(geomlib.data_path("cad_part.obj"))[0])
     make_meshes.CAD_EDGE *= np.sqrt(shipped / (1.05 * n))  # vertices grow as 1 / edge^2

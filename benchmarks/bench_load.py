@@ -30,7 +30,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import trimesh  # noqa: E402
 
 from geomlib import check_mesh, load_mesh, save_mesh  # noqa: E402
-from geomlib.io import parse_obj  # noqa: E402
+from geomlib.mesh.io import parse_obj  # noqa: E402
 
 
 def latlong_sphere(n_target, n_lon=1000):

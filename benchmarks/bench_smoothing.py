@@ -12,7 +12,7 @@ What is timed (wall clock, the same run, alternating, best of ``--repeat``):
 * ``implicit_smoothing(V, F, step, 10)`` with the operator kept fixed (cotan
   weights, barycentric areas): the operator is built once, ``M - step C`` is
   factorised once (sparse Cholesky, CHOLMOD through cholespy:
-  ``geomlib.factor``) and the factorisation solves the 10 iterations.
+  ``geomlib.numerics.factor``) and the factorisation solves the 10 iterations.
 * the baseline: the same operator built once (``geomlib.laplacian``), then
   ``scipy.sparse.linalg.spsolve(M - step C, M P)`` called every iteration, 10
   times, as a straightforward implementation does.
@@ -136,7 +136,7 @@ def slider_meshes():
 def bench_slider(repeat):
     """The callback of notebook 06's sliders on a 25k-vertex mesh, timed."""
     from geomlib import ImplicitSmoother
-    from geomlib.viewer import MeshView
+    from geomlib.teaching.viewer import MeshView
 
     slider = 10.0 ** np.arange(-1.0, 3.01, 0.25)  # the notebook's FloatLogSlider positions (step / h^2)
     for name, V, F in slider_meshes():

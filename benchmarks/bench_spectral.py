@@ -13,7 +13,7 @@ problem ``-C e = lam M e``:
 the same tiny shift ``s`` that geomlib uses. geomlib is timed with
 ``cache=False`` (a cold solve). Ratios are geomlib / reference: below 1 means
 geomlib is faster. geomlib runs its solver with one BLAS thread
-(``geomlib.eigen.one_blas_thread``); the reference is timed twice, with the
+(``geomlib.numerics.eigen.one_blas_thread``); the reference is timed twice, with the
 BLAS library's default thread count and with one thread, so the table shows
 what comes from the algorithm and what from avoiding thread contention.
 Runs alternate between the two solvers, after a warm-up on a small mesh; the
@@ -42,10 +42,10 @@ import scipy.sparse.linalg as sla
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import geomlib  # noqa: E402
-import geomlib.cache as basis_cache  # noqa: E402
+import geomlib.numerics.cache as basis_cache  # noqa: E402
 from geomlib import eigenbasis, laplacian, spectral_reconstruction  # noqa: E402
-from geomlib.eigen import one_blas_thread  # noqa: E402
-from geomlib.surfaces import icosphere, torus  # noqa: E402
+from geomlib.numerics.eigen import one_blas_thread  # noqa: E402
+from geomlib.teaching.surfaces import icosphere, torus  # noqa: E402
 
 CASES = [(5, 50), (5, 200), (6, 50), (6, 200), (7, 50)]  # (icosphere subdivisions, k)
 

@@ -15,86 +15,135 @@ Conventions that hold everywhere (see notebooks/00_getting_started.ipynb):
   1/length^2 (K); areas in length^2.
 
 Public names are imported lazily so that ``import geomlib`` stays fast; the
-symbolic module is ``geomlib.symbolic``.
+symbolic module is ``geomlib.symbolic`` and the exercise checks are
+``geomlib.check`` (both also importable by those names).
+
+Layers (one sub-package each; ``tests/test_layers.py`` holds the rule):
+
+* ``geomlib.mesh``: the mesh core (errors, validation, topology, geometry, I/O);
+* ``geomlib.numerics``: numerical machinery (factorisations, eigensolvers, caches, progress);
+* ``geomlib.lessons``: the formulas the notebooks derive;
+* ``geomlib.teaching``: viewers, exercise checks, notebook helpers, experiment drivers.
+
+The mesh core imports no other layer; numerics imports only the mesh core;
+lessons import the mesh core and numerics; teaching aids may import anything.
 """
 
+import sys
 from importlib import import_module
+from importlib.util import spec_from_loader
 
-from .errors import MeshError, MeshWarning  # noqa: F401  (public names, listed in __all__)
+from .mesh.errors import MeshError, MeshWarning  # noqa: F401  (public names, listed in __all__)
 
 __version__ = "0.1.0"
-import_module(".frontends", __name__).enable_colab_widgets()  # Colab draws the 3D views only after this
+import_module(".teaching.frontends", __name__).enable_colab_widgets()  # Colab draws the 3D views only after this
 
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
     # input / output and checks
-    "load_mesh": "io",
-    "save_mesh": "io",
-    "check_mesh": "report",
-    "MeshReport": "report",
+    "load_mesh": "mesh.io",
+    "save_mesh": "mesh.io",
+    "check_mesh": "mesh.report",
+    "MeshReport": "mesh.report",
     # topology
-    "edges": "topology",
-    "boundary_edges": "topology",
-    "boundary_vertices": "topology",
-    "boundary_loops": "topology",
-    "valence": "topology",
-    "one_ring": "topology",
-    "euler_characteristic": "topology",
-    "connected_components": "topology",
-    "vertex_face_adjacency": "topology",
+    "edges": "mesh.topology",
+    "boundary_edges": "mesh.topology",
+    "boundary_vertices": "mesh.topology",
+    "boundary_loops": "mesh.topology",
+    "valence": "mesh.topology",
+    "one_ring": "mesh.topology",
+    "euler_characteristic": "mesh.topology",
+    "connected_components": "mesh.topology",
+    "vertex_face_adjacency": "mesh.topology",
     # Laplacians and curvature
-    "laplacian": "laplace",
-    "cotangent_weights": "laplace",
-    "vertex_areas": "laplace",
-    "mean_curvature": "curvature",
-    "gaussian_curvature": "curvature",
-    "principal_curvatures": "curvature",
-    "vertex_normals": "geometry",
+    "laplacian": "lessons.laplace",
+    "cotangent_weights": "lessons.laplace",
+    "vertex_areas": "lessons.laplace",
+    "mean_curvature": "lessons.curvature",
+    "gaussian_curvature": "lessons.curvature",
+    "principal_curvatures": "lessons.curvature",
+    "vertex_normals": "mesh.geometry",
     # spectral
-    "eigenbasis": "spectral",
-    "spectral_reconstruction": "spectral",
-    "spectral_basis": "spectral",
-    "SpectralBasis": "spectral",
-    "spectral_cache_dir": "spectral",
-    "clear_spectral_cache": "spectral",
+    "eigenbasis": "lessons.spectral",
+    "spectral_reconstruction": "lessons.spectral",
+    "spectral_basis": "lessons.spectral",
+    "SpectralBasis": "lessons.spectral",
+    "spectral_cache_dir": "lessons.spectral",
+    "clear_spectral_cache": "lessons.spectral",
     # smoothing
-    "explicit_smoothing": "smoothing",
-    "implicit_smoothing": "smoothing",
-    "explicit_step_limit": "smoothing",
-    "highest_frequency_mode": "smoothing",
-    "fixed_point": "smoothing",
-    "ExplicitSmoother": "smoothing",
-    "ImplicitSmoother": "smoothing",
+    "explicit_smoothing": "lessons.smoothing",
+    "implicit_smoothing": "lessons.smoothing",
+    "explicit_step_limit": "lessons.smoothing",
+    "highest_frequency_mode": "lessons.smoothing",
+    "fixed_point": "lessons.smoothing",
+    "ExplicitSmoother": "lessons.smoothing",
+    "ImplicitSmoother": "lessons.smoothing",
     # noise and evaluation
-    "add_noise": "noise",
-    "bounding_box_diagonal": "geometry",
-    "vertex_rms": "metrics",
-    "hausdorff_distance": "metrics",
-    "face_normal_angles": "metrics",
-    "normal_angle_error": "metrics",
-    "area_change": "metrics",
-    "volume_change": "metrics",
-    "dihedral_angles": "metrics",
-    "sharp_edges": "metrics",
-    "sharp_edge_error": "metrics",
-    "denoising_metrics": "metrics",
-    "MeshComparison": "metrics",
-    "point_surface_distance": "metrics",
-    "smoothing_sweep": "sweep",
+    "add_noise": "lessons.noise",
+    "bounding_box_diagonal": "mesh.geometry",
+    "vertex_rms": "lessons.metrics",
+    "hausdorff_distance": "lessons.metrics",
+    "face_normal_angles": "lessons.metrics",
+    "normal_angle_error": "lessons.metrics",
+    "area_change": "lessons.metrics",
+    "volume_change": "lessons.metrics",
+    "dihedral_angles": "lessons.metrics",
+    "sharp_edges": "lessons.metrics",
+    "sharp_edge_error": "lessons.metrics",
+    "denoising_metrics": "lessons.metrics",
+    "MeshComparison": "lessons.metrics",
+    "point_surface_distance": "lessons.metrics",
+    "smoothing_sweep": "teaching.sweep",
 }
+
+# modules reachable by their short public names (geomlib.symbolic, geomlib.check, ...)
+_MODULES = {
+    "symbolic": "lessons.symbolic",
+    "check": "teaching.check",
+    "surfaces": "teaching.surfaces",
+    "viewer": "teaching.viewer",
+    "metrics": "lessons.metrics",
+    "sweep": "teaching.sweep",
+}
+
+
+class _ShortNames:
+    """Lets ``import geomlib.symbolic`` (and the other short names) find the module in its layer.
+
+    The module object is the layer's own, so ``geomlib.symbolic is geomlib.lessons.symbolic``.
+    """
+
+    @staticmethod
+    def find_spec(name, path=None, target=None):
+        short = name.rpartition(".")[2]
+        if not name.startswith(__name__ + ".") or name.count(".") != 1 or short not in _MODULES:
+            return None
+        module = import_module(f".{_MODULES[short]}", __name__)
+        return spec_from_loader(name, _ShortNames, origin=module.__spec__.origin)
+
+    @staticmethod
+    def create_module(spec):
+        return import_module(f".{_MODULES[spec.name.rpartition('.')[2]]}", __name__)
+
+    @staticmethod
+    def exec_module(module):
+        pass
+
+
+sys.meta_path.append(_ShortNames)
 
 __all__ = sorted(["MeshError", "MeshWarning", "data_path", *_EXPORTS])
 
 
 def data_path(name=""):
-    """Path of a mesh the workbook ships (``meshes/NAME`` in the repository).
+    """Path of a mesh the workbook ships (``geomlib/meshes/NAME``, package data of the wheel).
 
     ``data_path()`` is the folder itself. Raises MeshError naming the file and
     listing what is there when the mesh does not exist.
     """
     from pathlib import Path
 
-    folder = Path(__file__).resolve().parent.parent / "meshes"
+    folder = Path(__file__).resolve().parent / "meshes"
     path = folder / name
     if name and not path.exists():
         have = sorted(p.name for p in folder.glob("*") if p.suffix in (".obj", ".off", ".ply", ".stl"))
@@ -107,8 +156,8 @@ def __getattr__(name):
         value = getattr(import_module(f".{_EXPORTS[name]}", __name__), name)
         globals()[name] = value
         return value
-    if name in ("symbolic", "surfaces", "viewer", "metrics", "sweep"):
-        return import_module(f".{name}", __name__)
+    if name in _MODULES:
+        return import_module(f".{_MODULES[name]}", __name__)
     raise AttributeError(f"module 'geomlib' has no attribute {name!r}")
 
 

@@ -1,7 +1,7 @@
 """Test-suite set-up shared by every test.
 
 Notebooks run by nbval with their default parameters must hold every claim of
-their text: ``GEOMLIB_STRICT_CLAIMS=1`` makes ``geomlib.notebook.claim`` (and a
+their text: ``GEOMLIB_STRICT_CLAIMS=1`` makes ``geomlib.teaching.notebook.claim`` (and a
 failed exercise check of a written function) raise instead of showing a note.
 The kernels nbval starts inherit this environment. Runs with a reader's
 inputs (tests/notebook_runner.py) set it to 0 for their own kernels.

@@ -13,7 +13,7 @@ import pytest
 from geomlib import MeshWarning, load_mesh
 
 ROOT = Path(__file__).resolve().parents[1]
-SHIPPED = ROOT / "meshes"
+SHIPPED = ROOT / "geomlib" / "meshes"
 COURSE = ROOT.parent / "shared" / "meshes"
 
 SHIPPED_MESHES = sorted(p.name for p in SHIPPED.glob("*.obj"))

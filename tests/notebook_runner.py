@@ -8,7 +8,7 @@ executes it top to bottom with nbclient in a fresh kernel with
 strings, numbers, lists, or ``Raw("python expression")``.
 
 It returns a ``Run`` with the executed notebook, the wall time, the notes the
-notebook displayed (``geomlib.notebook.note``; text/plain starting ``Note:``),
+notebook displayed (``geomlib.teaching.notebook.note``; text/plain starting ``Note:``),
 and every error output. A cell that raises stops the run and is reported with
 its index and traceback by ``Run.assert_ran()``.
 """

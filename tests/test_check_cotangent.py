@@ -9,8 +9,8 @@ import pytest
 import scipy.sparse as sp
 
 from geomlib import check
-from geomlib.check import CheckFailed
-from geomlib.laplace import barycentric_areas, laplacian, mixed_areas
+from geomlib.lessons.laplace import barycentric_areas, laplacian, mixed_areas
+from geomlib.teaching.check import CheckFailed
 
 
 @pytest.fixture(autouse=True)

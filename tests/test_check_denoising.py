@@ -7,7 +7,7 @@ import pytest
 
 import geomlib
 from geomlib import check
-from geomlib.geometry import bounding_box_diagonal, mean_edge_length
+from geomlib.mesh.geometry import bounding_box_diagonal, mean_edge_length
 
 
 @pytest.fixture(autouse=True)

@@ -63,7 +63,7 @@ def test_forms_accept_reference_simplified_or_not():
     for fn in (forms, as_matrices):
         result = check.fundamental_forms(fn)
         assert result.passed, result.message
-    from geomlib.symbolic import ellipsoid
+    from geomlib.lessons.symbolic import ellipsoid
 
     def library(a, b, c, u, v):
         ell = ellipsoid(a, b, c)

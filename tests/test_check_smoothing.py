@@ -12,8 +12,8 @@ import scipy.sparse.linalg as sla
 
 from geomlib import check, laplacian
 from geomlib import explicit_step_limit as reference_limit_of_mesh
-from geomlib.check import CheckFailed
-from geomlib.smoothing import explicit_step, implicit_step
+from geomlib.lessons.smoothing import explicit_step, implicit_step
+from geomlib.teaching.check import CheckFailed
 
 
 @pytest.fixture(autouse=True)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from geomlib import check, eigenbasis, laplacian, spectral_reconstruction
-from geomlib.check import CheckFailed
+from geomlib.teaching.check import CheckFailed
 
 
 @pytest.fixture(autouse=True)

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from geomlib import check
-from geomlib.check import CheckFailed
-from geomlib.curvature import angle_deficit, gaussian_curvature
-from geomlib.laplace import barycentric_areas, laplacian, mixed_areas
+from geomlib.lessons.curvature import angle_deficit, gaussian_curvature
+from geomlib.lessons.laplace import barycentric_areas, laplacian, mixed_areas
+from geomlib.teaching.check import CheckFailed
 
 
 @pytest.fixture(autouse=True)
@@ -98,7 +98,7 @@ def test_K_accepts_reference_and_written_solution():
 
 def test_mixed_and_barycentric_differ_on_the_check_mesh():
     # otherwise the "mixed area" diagnosis could not be told apart from a correct answer
-    from geomlib.check.uniform import _TET_F, _TET_V
+    from geomlib.teaching.check.uniform import _TET_F, _TET_V
 
     assert not np.allclose(mixed_areas(_TET_V, _TET_F), barycentric_areas(_TET_V, _TET_F))
 

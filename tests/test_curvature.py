@@ -1,4 +1,4 @@
-"""Tests of geomlib.curvature: closed forms, Gauss-Bonnet, laws, boundary rules, bad input, libigl."""
+"""Tests of geomlib.lessons.curvature: closed forms, Gauss-Bonnet, laws, boundary rules, bad input, libigl."""
 
 import warnings
 
@@ -15,7 +15,7 @@ from geomlib import (
     principal_curvatures,
     surfaces,
 )
-from geomlib.curvature import BOUNDARY_RULES, angle_sums, boundary_mask
+from geomlib.lessons.curvature import BOUNDARY_RULES, angle_sums, boundary_mask
 
 
 def euler_characteristic(V, F):
@@ -358,7 +358,7 @@ def test_boundary_detection_ignores_orientation_flips():
 
 
 def test_corner_angles_and_angle_deficit_against_libigl():
-    from geomlib.curvature import angle_deficit, corner_angles
+    from geomlib.lessons.curvature import angle_deficit, corner_angles
 
     V, F = surfaces.ellipsoid(1.0, 0.7, 0.5, 3).V, surfaces.ellipsoid(1.0, 0.7, 0.5, 3).F
     np.testing.assert_allclose(corner_angles(V, F), igl.internal_angles(V, F), atol=1e-13)
@@ -366,7 +366,7 @@ def test_corner_angles_and_angle_deficit_against_libigl():
 
 
 def test_corner_angles_of_a_3_4_5_triangle_and_a_collinear_one():
-    from geomlib.curvature import corner_angles
+    from geomlib.lessons.curvature import corner_angles
 
     V = np.array([[0.0, 0, 0], [4, 0, 0], [0, 3, 0], [8, 0, 0]])
     theta = corner_angles(V, [[0, 1, 2]])

@@ -1,4 +1,4 @@
-"""geomlib.filters: the per-mode factor of each smoothing step, against its formula and the
+"""geomlib.lessons.filters: the per-mode factor of each smoothing step, against its formula and the
 inequalities the notebooks quote (1/(1 + x) > exp(-x) > 1 - x for x > 0)."""
 
 import matplotlib
@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import numpy as np
 import pytest
 
-from geomlib.filters import SCHEMES, mode_factor, plot_mode_factors
+from geomlib.lessons.filters import SCHEMES, mode_factor, plot_mode_factors
 
 
 def test_factors_at_known_points():

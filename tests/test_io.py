@@ -1,4 +1,4 @@
-"""Tests for geomlib.io: exact vertex order, OBJ syntax, round trips, and bad files.
+"""Tests for geomlib.mesh.io: exact vertex order, OBJ syntax, round trips, and bad files.
 
 Every bad-input case checks the message: the problem, and where (path, line,
 vertex or face indices).

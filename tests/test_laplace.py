@@ -1,4 +1,4 @@
-"""Tests of geomlib.laplace: closed forms, matrix laws, bad triangles, libigl cross-checks."""
+"""Tests of geomlib.lessons.laplace: closed forms, matrix laws, bad triangles, libigl cross-checks."""
 
 import warnings
 
@@ -9,7 +9,7 @@ import trimesh
 from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, needs_course
 
 from geomlib import MeshError, MeshWarning, cotangent_weights, laplacian, load_mesh, surfaces, vertex_areas
-from geomlib.laplace import (
+from geomlib.lessons.laplace import (
     barycentric_areas,
     cotangent_matrix,
     face_geometry,

@@ -5,7 +5,7 @@ import pytest
 import trimesh
 
 from geomlib import MeshError
-from geomlib.metrics import (
+from geomlib.lessons.metrics import (
     MeshComparison,
     area_change,
     bounding_box_diagonal,
@@ -25,7 +25,7 @@ from geomlib.metrics import (
     vertex_rms,
     volume_change,
 )
-from geomlib.noise import add_noise
+from geomlib.lessons.noise import add_noise
 
 
 def icosphere(subdivisions=3, radius=1.0):
@@ -333,7 +333,7 @@ def test_interior_edges_of_an_open_grid():
 def test_smoothing_a_cube_rounds_its_sharp_edges():
     # moving every vertex towards its neighbours' mean flattens the folds
     V, F = cube()
-    from geomlib.laplace import uniform_adjacency
+    from geomlib.lessons.laplace import uniform_adjacency
 
     A = uniform_adjacency(len(V), F)
     W = 0.5 * V + 0.5 * (A @ V) / A.sum(axis=1)
@@ -382,7 +382,7 @@ SCHEMES = [("explicit", "uniform"), ("explicit", "cotan"), ("implicit", "uniform
 
 def smooth(V, F, method, weights, value, iterations):
     from geomlib import explicit_smoothing, implicit_smoothing
-    from geomlib.sweep import scale_free_step
+    from geomlib.teaching.sweep import scale_free_step
 
     step = scale_free_step(V, F, method, weights, value)
     run = explicit_smoothing if method == "explicit" else implicit_smoothing
@@ -421,7 +421,7 @@ def test_smoothing_a_clean_sphere_only_shrinks_it(method, weights):
 
 
 def test_sweep_records_what_a_direct_run_gives():
-    from geomlib.sweep import smoothing_sweep
+    from geomlib.teaching.sweep import smoothing_sweep
 
     V, F = icosphere(2)
     R = smoothing_sweep(

@@ -5,8 +5,8 @@ import pytest
 import trimesh
 
 from geomlib import MeshError, add_noise
-from geomlib.curvature import vertex_normals
-from geomlib.metrics import bounding_box_diagonal
+from geomlib.lessons.curvature import vertex_normals
+from geomlib.lessons.metrics import bounding_box_diagonal
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +94,7 @@ def test_bad_mesh_raises_mesh_error_naming_the_faces():
 
 
 def test_normal_noise_moves_along_the_geometry_vertex_normals():
-    from geomlib.geometry import vertex_normals
+    from geomlib.mesh.geometry import vertex_normals
 
     V, F = _sphere()
     W = add_noise(V, F, 0.01, seed=4, direction="normal")
@@ -104,6 +104,6 @@ def test_normal_noise_moves_along_the_geometry_vertex_normals():
 
 
 def _sphere():
-    from geomlib.surfaces import icosphere as ico
+    from geomlib.teaching.surfaces import icosphere as ico
 
     return ico(2)

@@ -1,30 +1,30 @@
-"""geomlib.notebook (show_source, explain, claim, note) and the check vocabulary."""
+"""geomlib.teaching.notebook (show_source, explain, claim, note) and the check vocabulary."""
 
 import numpy as np
 import pytest
 
 import geomlib
 from geomlib import check
-from geomlib.check.result import CheckFailed, Mistake, call, exercise, matrix_pair, use, vector
-from geomlib.notebook import NOTE_PREFIX, ClaimFailed, claim, explain, note, show_source
+from geomlib.teaching.check.result import CheckFailed, Mistake, call, exercise, matrix_pair, use, vector
+from geomlib.teaching.notebook import NOTE_PREFIX, ClaimFailed, claim, explain, note, show_source
 
 
 @pytest.fixture
 def shown(monkeypatch):
     """What the helpers display, as a list of mime bundles."""
     out = []
-    monkeypatch.setattr("geomlib.notebook._display", out.append)
+    monkeypatch.setattr("geomlib.teaching.notebook._display", out.append)
     return out
 
 
 def test_show_source_names_the_file_and_lines_and_highlights():
     src = show_source(geomlib.laplacian)
     text = repr(src)
-    assert text.startswith("# laplacian — geomlib/laplace.py, lines ")
+    assert text.startswith("# laplacian — geomlib/lessons/laplace.py, lines ")
     assert "def laplacian(V, F" in text
     first = int(text.split("lines ")[1].split("–")[0])
-    assert open(geomlib.laplace.__file__).read().splitlines()[first - 1].startswith("def laplacian(")
-    assert "<span" in src._repr_html_() and "geomlib/laplace.py" in src._repr_html_()
+    assert open(geomlib.lessons.laplace.__file__).read().splitlines()[first - 1].startswith("def laplacian(")
+    assert "<span" in src._repr_html_() and "geomlib/lessons/laplace.py" in src._repr_html_()
 
 
 def test_show_source_of_a_check_shows_its_body_not_the_wrapper():
@@ -148,7 +148,7 @@ def test_braces_in_the_values_are_not_placeholders(shown, monkeypatch):
 
 
 def test_loop_over_meshes_shows_a_bar_only_for_large_meshes(capsys):
-    from geomlib.progress import LARGE_MESH, loop
+    from geomlib.numerics.progress import LARGE_MESH, loop
 
     assert list(loop(range(3), "small meshes", LARGE_MESH)) == [0, 1, 2]
     assert capsys.readouterr().err == ""

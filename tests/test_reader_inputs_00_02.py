@@ -3,7 +3,7 @@ at both ends of its documented range. No run may raise; the notes a run shows mu
 
 The runs are chosen to take different code paths (flat mesh, unused vertices and holes, two components,
 a model in millimetres, coarse and fine resolutions, a spheroid); several parameters move together per run.
-Notebook 01 and 00 share the cleaning step (geomlib.repair.prepare), so the scan with holes runs in 00 only.
+Notebook 01 and 00 share the cleaning step (geomlib.mesh.repair.prepare), so the scan with holes runs in 00 only.
 """
 
 import json
@@ -15,7 +15,7 @@ from awkward_meshes import make_all
 from meshdata import COURSE, ROOT, needs_course
 from notebook_runner import Raw, run_notebook
 
-from geomlib import surfaces
+from geomlib.teaching import surfaces
 
 NB00, NB01, NB02 = "00_getting_started.ipynb", "01_uniform_laplace_curvature.ipynb", "02_fundamental_forms.ipynb"
 

@@ -43,7 +43,7 @@ def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
     said(
         run,
         "12 vertices are not used by any face",
-        "geomlib.repair.remove_unreferenced_vertices",
+        "geomlib.mesh.repair.remove_unreferenced_vertices",
         "does not converge on jittered meshes",
         "JITTER = 0.1",
         "VIEW_LEVEL = 1",
@@ -77,7 +77,7 @@ def test_03_cad_part_long_ellipsoid(tmp_path):
 def test_04_scan_with_unused_vertices(tmp_path):
     # issue 11: unused vertices gave divide-by-zero warnings, NaN in S, then an assert
     run = ran(NB04, MESH=str(scan_with_holes(tmp_path)), K_VALUES=(1, 2, 30), SPHERE_LEVEL=3, SMALL_LEVEL=0)
-    said(run, "12 vertices are not used by any face", "geomlib.repair.remove_unreferenced_vertices")
+    said(run, "12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
     text = run.outputs_text()
     assert "divide by zero" not in text and "invalid value" not in text
 

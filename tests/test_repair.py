@@ -1,10 +1,11 @@
-"""geomlib.repair: each cleaning step on a case with a known answer."""
+"""geomlib.mesh.repair: each cleaning step on a case with a known answer."""
 
 import numpy as np
 import pytest
 
 from geomlib import MeshError, surfaces
-from geomlib.repair import largest_component, prepare, remove_unreferenced_vertices, remove_zero_area_faces
+from geomlib.mesh.repair import largest_component, remove_unreferenced_vertices, remove_zero_area_faces
+from geomlib.teaching.notebook import prepare
 
 
 def _two_spheres():
@@ -37,7 +38,7 @@ def test_zero_area_faces_are_dropped():
 
 def test_prepare_says_what_it_did(monkeypatch):
     said = []
-    monkeypatch.setattr("geomlib.notebook.note", lambda text, **kw: said.append(text))
+    monkeypatch.setattr("geomlib.teaching.notebook.note", lambda text, **kw: said.append(text))
     V, F, na = _two_spheres()
     V = np.vstack([V, [[50.0, 0, 0]]])
     V2, F2, kept = prepare(V, F, one_component=True)
@@ -49,7 +50,7 @@ def test_prepare_says_what_it_did(monkeypatch):
 
 def test_prepare_leaves_a_clean_mesh_alone(monkeypatch):
     said = []
-    monkeypatch.setattr("geomlib.notebook.note", lambda text, **kw: said.append(text))
+    monkeypatch.setattr("geomlib.teaching.notebook.note", lambda text, **kw: said.append(text))
     s = surfaces.sphere(1.0, subdivisions=1)
     V2, F2, kept = prepare(s.V, s.F, one_component=True, closed=True)
     assert said == [] and np.array_equal(V2, s.V) and np.array_equal(kept, np.arange(len(s.V)))

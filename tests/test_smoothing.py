@@ -1,4 +1,4 @@
-"""Laws of explicit and implicit Laplacian smoothing (geomlib.smoothing)."""
+"""Laws of explicit and implicit Laplacian smoothing (geomlib.lessons.smoothing)."""
 
 import warnings
 
@@ -10,7 +10,7 @@ import trimesh
 from meshdata import COURSE
 
 from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_limit, implicit_smoothing, laplacian
-from geomlib.smoothing import (
+from geomlib.lessons.smoothing import (
     ExplicitSmoother,
     ImplicitSmoother,
     _volume_centroid,
@@ -19,7 +19,7 @@ from geomlib.smoothing import (
     highest_frequency_mode,
     implicit_step,
 )
-from geomlib.topology import boundary_vertices
+from geomlib.mesh.topology import boundary_vertices
 
 
 def _boundary_mask(F, n):
@@ -502,7 +502,7 @@ def test_the_formulas_are_one_step_of_the_smoothers():
 
 
 def test_not_positive_definite_is_a_clear_error():
-    from geomlib.factor import factorise
+    from geomlib.numerics.factor import factorise
 
     with pytest.raises(np.linalg.LinAlgError, match="not positive definite"):
         factorise(sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]])))
@@ -564,7 +564,7 @@ def test_smoother_history_matches_fresh_runs():
 
 
 def test_progress_bar_appears_for_long_runs(monkeypatch, capsys):
-    import geomlib.progress as progress
+    import geomlib.numerics.progress as progress
 
     V, F = icosphere(2)
     monkeypatch.setattr(progress, "SECONDS", 0.0)  # every run counts as long
@@ -587,7 +587,7 @@ def test_prepare_factorises_and_keeps_iterates():
 
 
 def test_prepare_shows_progress_when_long(monkeypatch, capsys):
-    from geomlib import progress
+    from geomlib.numerics import progress
 
     V, F = icosphere(2)
     monkeypatch.setattr(progress, "SECONDS", 0.0)

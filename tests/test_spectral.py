@@ -1,4 +1,4 @@
-"""Tests for geomlib.spectral: C e = -lam M e, E^T M E = I, reconstruction, cache."""
+"""Tests for geomlib.lessons.spectral: C e = -lam M e, E^T M E = I, reconstruction, cache."""
 
 import sys
 import warnings
@@ -8,8 +8,8 @@ import pytest
 from meshdata import COURSE
 
 import geomlib
-import geomlib.cache as basis_cache
-import geomlib.eigen as eigen
+import geomlib.numerics.cache as basis_cache
+import geomlib.numerics.eigen as eigen
 from geomlib import (
     MeshError,
     MeshWarning,
@@ -20,7 +20,7 @@ from geomlib import (
     spectral_cache_dir,
     spectral_reconstruction,
 )
-from geomlib.surfaces import ellipsoid, icosphere, sphere
+from geomlib.teaching.surfaces import ellipsoid, icosphere, sphere
 
 
 @pytest.fixture(autouse=True)
@@ -304,7 +304,7 @@ def test_isolated_vertex_is_named(egg):
     with pytest.raises(
         MeshError,
         match=rf"1 vertices are used by no face \({len(V)}\).*"
-        r"geomlib.repair.remove_unreferenced_vertices\(V, F\)",
+        r"geomlib.mesh.repair.remove_unreferenced_vertices\(V, F\)",
     ):
         eigenbasis(V2, F, 5, cache=False)
     with pytest.raises(MeshError, match="remove_unreferenced_vertices"):
@@ -489,7 +489,7 @@ def test_blas_thread_setting_is_restored(egg):
 
 
 def test_long_solves_show_their_stages(egg_fine, monkeypatch, capsys):
-    import geomlib.progress as progress
+    import geomlib.numerics.progress as progress
 
     V, F = egg_fine
     monkeypatch.setattr(progress, "SECONDS", -1.0)  # every solve counts as long

@@ -1,10 +1,10 @@
-"""Tests of geomlib.surfaces: exact truth, exact placement, closed and oriented meshes."""
+"""Tests of geomlib.teaching.surfaces: exact truth, exact placement, closed and oriented meshes."""
 
 import numpy as np
 import pytest
 
 from geomlib import MeshError
-from geomlib import surfaces as S
+from geomlib.teaching import surfaces as S
 
 # ---------------------------------------------------------------------------
 # independent helpers (written here, not imported from the module under test)

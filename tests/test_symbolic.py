@@ -1,4 +1,4 @@
-"""Tests of geomlib.symbolic against independent checks.
+"""Tests of geomlib.lessons.symbolic against independent checks.
 
 Closed forms (sphere 1/r, torus equators, saddle, the ellipsoid's K and H in
 Cartesian form), finite differences of p written out here in numpy, the
@@ -12,13 +12,13 @@ import sympy as sp
 from scipy.optimize import brentq
 
 from geomlib import symbolic
-from geomlib.symbolic import ellipsoid, helicoid, monge, saddle, sphere, torus
+from geomlib.lessons.symbolic import ellipsoid, helicoid, monge, saddle, sphere, torus
 
 RNG_SEED = 20240611
 
 
 # ----------------------------------------------------------------- numpy models
-# Written independently of geomlib.symbolic: plain numpy formulas of p(u, v).
+# Written independently of geomlib.lessons.symbolic: plain numpy formulas of p(u, v).
 def p_ellipsoid(a, b, c):
     return lambda u, v: np.stack([a * np.cos(u) * np.sin(v), b * np.sin(u) * np.sin(v), c * np.cos(v) + 0 * u], axis=-1)
 

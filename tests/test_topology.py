@@ -1,4 +1,4 @@
-"""Tests for geomlib.topology: closed-form counts, orientation laws, course meshes."""
+"""Tests for geomlib.mesh.topology: closed-form counts, orientation laws, course meshes."""
 
 import numpy as np
 import pytest
@@ -281,7 +281,7 @@ def test_camel_pinch_vertex_one_ring():
 
 
 def test_loop_chaining_vectorised_matches_walk():
-    from geomlib.topology import _loops_vectorised, _loops_walk
+    from geomlib.mesh.topology import _loops_vectorised, _loops_walk
 
     V, F = grid(7)
     holed = F[~np.isin(F, [16, 17, 23, 24]).any(axis=1)]
@@ -299,7 +299,7 @@ def test_loop_chaining_vectorised_matches_walk():
 
 
 def test_edge_face_counts_boundary_counts_and_face_pairs():
-    from geomlib.topology import Topology, boundary_edge_counts, edge_face_counts
+    from geomlib.mesh.topology import Topology, boundary_edge_counts, edge_face_counts
 
     # a square of two triangles, and a third triangle on edge (0, 1) below it
     F = np.array([[0, 1, 2], [0, 2, 3], [1, 0, 4]])
@@ -314,7 +314,7 @@ def test_edge_face_counts_boundary_counts_and_face_pairs():
 
 
 def test_unreferenced_vertices_and_non_manifold_edges():
-    from geomlib.topology import non_manifold_edges, unreferenced_vertices
+    from geomlib.mesh.topology import non_manifold_edges, unreferenced_vertices
 
     F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 5]])
     assert unreferenced_vertices(F, 7).tolist() == [4, 6]

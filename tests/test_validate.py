@@ -1,4 +1,4 @@
-"""Tests for geomlib.validate: as_mesh at the door, check_mesh and MeshReport."""
+"""Tests for geomlib.mesh.validate: as_mesh at the door, check_mesh and MeshReport."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import trimesh
 from meshdata import COURSE, needs_course
 
 from geomlib import MeshError, MeshReport, check_mesh, load_mesh
-from geomlib.validate import as_faces, as_mesh
+from geomlib.mesh.validate import as_faces, as_mesh
 
 
 def icosahedron():
@@ -266,8 +266,8 @@ def test_course_boundary_loops(name, loops):
 
 
 def test_is_zero_area_is_scale_free_and_zero_area_faces_uses_it():
-    from geomlib.geometry import zero_area_faces
-    from geomlib.validate import is_zero_area
+    from geomlib.mesh.geometry import zero_area_faces
+    from geomlib.mesh.validate import is_zero_area
 
     assert is_zero_area(np.array([0.0, 1e-13, 1e-11]), np.ones(3)).tolist() == [True, True, False]
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1e-14, 0]])
@@ -277,8 +277,8 @@ def test_is_zero_area_is_scale_free_and_zero_area_faces_uses_it():
 
 
 def test_check_mesh_lives_in_report_and_validate_does_not_import_topology():
-    import geomlib.report
-    import geomlib.validate
+    import geomlib.mesh.report
+    import geomlib.mesh.validate
 
-    assert geomlib.check_mesh is geomlib.report.check_mesh
-    assert "topology" not in open(geomlib.validate.__file__).read()
+    assert geomlib.check_mesh is geomlib.mesh.report.check_mesh
+    assert "topology" not in open(geomlib.mesh.validate.__file__).read()

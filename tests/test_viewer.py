@@ -1,4 +1,4 @@
-"""Tests of geomlib.viewer: colour mapping, in-place updates, normals, the still
+"""Tests of geomlib.teaching.viewer: colour mapping, in-place updates, normals, the still
 picture in the display bundle, linked cameras and input checks.
 
 The browser side (does the canvas really show the mesh, does a slider change
@@ -17,7 +17,15 @@ import trimesh
 from PIL import Image
 
 from geomlib import MeshError
-from geomlib.viewer import NAN_COLOR, MeshView, colorize, render_still, side_by_side, value_range, vertex_normals_fast
+from geomlib.teaching.viewer import (
+    NAN_COLOR,
+    MeshView,
+    colorize,
+    render_still,
+    side_by_side,
+    value_range,
+    vertex_normals_fast,
+)
 
 
 @pytest.fixture(scope="module")
@@ -204,7 +212,7 @@ def test_mimebundle_has_widget_png_and_text(sphere):
 
 def test_still_puts_the_mesh_in_the_middle():
     # a unit square facing the camera direction fills the middle, corners stay background
-    from geomlib.viewer import UP, VIEW_DIRECTION, _basis
+    from geomlib.teaching.viewer import UP, VIEW_DIRECTION, _basis
 
     right, up, w = _basis(VIEW_DIRECTION, UP)
     corners = np.array([-right - up, right - up, right + up, -right + up])
@@ -341,7 +349,7 @@ def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
 
 
 def test_a_field_zero_up_to_rounding_draws_white(sphere):
-    from geomlib.viewer import ZERO_COLOR
+    from geomlib.teaching.viewer import ZERO_COLOR
 
     V, F = sphere
     rounding = 8e-13 * np.sin(7 * V[:, 0])  # a flat mesh's H, say: zero but for rounding

@@ -6,7 +6,7 @@
 The notebooks in notebooks/ are the solution version. An exercise's solution
 is marked as nbgrader marks it: the code cell has the metadata
 ``nbgrader.solution = true`` with ``grade_id`` naming its check in
-``geomlib.check``, and the solution lines sit between ``### BEGIN SOLUTION``
+``geomlib.teaching.check``, and the solution lines sit between ``### BEGIN SOLUTION``
 and ``### END SOLUTION``. Each such block becomes, at the same indentation,
 
     raise NotImplementedError("Your turn: ... reread <the derivation>")
@@ -53,7 +53,7 @@ def solution_cells(nb):
 
 def build(out):
     sys.path.insert(0, str(ROOT))
-    import geomlib.check as check
+    import geomlib.teaching.check as check
 
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -63,7 +63,7 @@ def build(out):
             exercise = cell.metadata["nbgrader"]["grade_id"]
             checker = getattr(check, exercise, None)
             if checker is None or not hasattr(checker, "reread"):
-                raise SystemExit(f"{path.name}: solution cell {exercise!r} names no check in geomlib.check")
+                raise SystemExit(f"{path.name}: solution cell {exercise!r} names no check in geomlib.teaching.check")
             cell.source = stub_source(cell.source, exercise, checker.reread)
         for cell in nb.cells:
             if (

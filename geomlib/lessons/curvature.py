@@ -1,0 +1,254 @@
+"""Lesson (notebooks 01 and 03): discrete mean and Gaussian curvature: pointwise values, H in 1/length, K in 1/length^2.
+
+Sign convention: ``Delta x = -2 H n`` with ``Delta = M^-1 C`` (geomlib.lessons.laplace)
+and ``n`` the outward unit normal; ``H > 0`` and ``K > 0`` on a sphere.
+
+Boundary rules, in one place (each function's docstring repeats its own):
+
+* ``mean_curvature``: ``boundary="formula"`` (default) applies ``1/2 |Delta x|``
+  everywhere. At a boundary vertex the one-ring is incomplete, ``Delta x`` has a
+  large in-plane component and the value is not a curvature estimate (it is
+  large even on a flat plane). ``"nan"`` masks boundary vertices, ``"zero"``
+  sets them to 0.
+* ``gaussian_curvature``: ``boundary="nan"`` (default) masks boundary vertices,
+  because the angle deficit ``2 pi - sum theta`` is not defined there;
+  ``"zero"``; ``"turning"``: the boundary turning angle ``pi - sum theta``
+  (the discrete geodesic curvature of the boundary), with which the integrated
+  values sum to ``2 pi chi`` exactly (Gauss-Bonnet with the boundary term);
+  ``"deficit"``: the interior formula applied anyway (what a naive
+  implementation reports, about ``pi / A`` too large on a flat boundary).
+
+A boundary vertex is a vertex of an edge that belongs to exactly one triangle.
+
+Bad input (each named in a MeshWarning, never a silent NaN): a vertex in no
+triangle of non-zero area gets NaN (its area is 0, nothing can be divided by
+it); a zero-area triangle counts as flat and collinear (angle pi at the corner
+opposite its longest edge, 0 at the others), so Gauss-Bonnet stays exact; at a
+non-manifold vertex (several fans of triangles) the deficit is
+``2 pi - sum theta`` over all its triangles, which keeps the total equal to
+``2 pi chi`` of the mesh as given but is not a pointwise curvature estimate;
+edges with three or more triangles count as interior and are reported when
+they unbalance the orientation around a vertex (always so for an odd number of
+triangles; ``geomlib.check_mesh`` lists them all).
+"""
+
+import warnings
+
+import numpy as np
+
+from ..mesh.errors import MeshError, MeshWarning, format_indices
+from ..mesh.geometry import face_normals, vertex_normals
+from ..mesh.topology import boundary_edge_counts, edge_face_counts
+from ..mesh.validate import as_mesh
+from .laplace import check_options, face_geometry, laplacian, vertex_areas
+
+__all__ = [
+    "mean_curvature",
+    "gaussian_curvature",
+    "principal_curvatures",
+    "angle_deficit",
+    "angle_sums",
+    "corner_angles",
+    "vertex_normals",
+    "face_normals",
+    "boundary_mask",
+    "BOUNDARY_RULES",
+    "MEAN_BOUNDARY_RULES",
+]
+
+BOUNDARY_RULES = ("nan", "zero", "turning", "deficit")
+MEAN_BOUNDARY_RULES = ("formula", "nan", "zero")
+
+
+def _warn(message):
+    warnings.warn(message, MeshWarning, stacklevel=3)
+
+
+def boundary_mask(V, F):
+    """Boolean (n,): True at the vertices of an edge that belongs to exactly one triangle."""
+    V, F = as_mesh(V, F)
+    return boundary_edge_counts(F, len(V)) > 0
+
+
+def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boundary="formula"):
+    """Pointwise mean curvature H (n,) float64 from ``Delta x = -2 H n``: ``H = 1/2 |Delta x|``.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64, counter-clockwise seen from outside.
+    weights, area
+        As in :func:`geomlib.laplacian`.
+    signed : bool
+        False: ``H = 1/2 |Delta x| >= 0``. True: ``H = -1/2 <Delta x, n>`` with
+        ``n`` the area-weighted outward vertex normal: H > 0 on a sphere.
+    boundary : {"formula", "nan", "zero"}
+        Value at boundary vertices: the formula applied anyway (default; the
+        one-ring is incomplete, ``Delta x`` has an in-plane part and the value
+        is large even on a flat plane), NaN, or 0.
+
+    Returns
+    -------
+    H : (n,) float64
+        1/length for ``weights="cotan"``. For ``"uniform"`` it is half the
+        umbrella vector (Taubin 1995): a length, not a curvature. NaN (with a
+        MeshWarning) at vertices in no triangle of non-zero area, where M is 0.
+        Meyer et al. 2003, section 3.5; Desbrun et al. 1999.
+    """
+    check_options(weights, area)
+    if boundary not in MEAN_BOUNDARY_RULES:
+        raise MeshError(f"boundary must be one of {MEAN_BOUNDARY_RULES}, not {boundary!r}")
+    V, F = as_mesh(V, F)
+    M, C = laplacian(V, F, weights, area)
+    A = M.diagonal()
+    if (A <= 0).any():
+        _warn(
+            f"{(A <= 0).sum()} vertex/vertices belong to no triangle of non-zero area; their curvature "
+            f"is undefined and returned as NaN: vertices {format_indices(np.flatnonzero(A <= 0))}"
+        )
+    DV = (C @ V) / np.where(A > 0, A, np.nan)[:, None]  # Delta x = M^-1 C x
+    if signed:
+        H = -0.5 * np.einsum("ij,ij->i", DV, vertex_normals(V, F))
+    else:
+        H = 0.5 * np.linalg.norm(DV, axis=1)
+    if boundary != "formula":
+        on_boundary = boundary_mask(V, F)
+        H[on_boundary] = np.nan if boundary == "nan" else 0.0
+        if on_boundary.all():
+            _warn(
+                f"every vertex of this mesh lies on the boundary; boundary={boundary!r} gives "
+                f"{'NaN' if boundary == 'nan' else '0'} everywhere (boundary='formula' keeps the values)"
+            )
+    return H
+
+
+def corner_angles(V, F):
+    """Angles (m, 3) in radians at the corners of each face.
+
+    ``theta_i = atan2(2A, <e_j, -e_k>)`` with ``<e_j, -e_k> = (l_j^2 + l_k^2 - l_i^2) / 2``
+    (accurate for needles). A zero-area triangle counts as collinear: pi at
+    the corner opposite its longest edge, 0 at the others, so the angles of
+    every triangle sum to pi.
+    """
+    l2, dblA, _, degenerate = face_geometry(V, F)
+    l2 = l2.T  # (3, m): one row per corner
+    theta = np.arctan2(dblA, 0.5 * l2.sum(axis=0) - l2)
+    flat = np.flatnonzero(degenerate)
+    theta[:, flat] = 0.0
+    theta[np.argmax(l2[:, flat], axis=0), flat] = np.pi
+    return theta.T
+
+
+def angle_sums(V, F):
+    """Sum of the triangle angles at each vertex (n,) float64, radians; 0 at unreferenced vertices."""
+    V, F = as_mesh(V, F)
+    theta = corner_angles(V, F)
+    return np.bincount(F.T.ravel(), theta.T.ravel(), minlength=len(V))  # corner by corner: rows are contiguous
+
+
+def angle_deficit(V, F):
+    """Integrated Gaussian curvature (n,) in radians: ``2 pi - sum_j theta_j``, the interior rule everywhere.
+
+    Summed over a closed mesh it is exactly ``2 pi chi`` (discrete
+    Gauss-Bonnet). At boundary vertices this is not a curvature (see
+    :func:`gaussian_curvature` for the boundary rules). NaN, with a
+    MeshWarning, at vertices in no triangle.
+    """
+    V, F = as_mesh(V, F)
+    deficit = 2.0 * np.pi - angle_sums(V, F)
+    unreferenced = np.bincount(F.ravel(), minlength=len(V)) == 0
+    if unreferenced.any():
+        _warn(
+            f"{unreferenced.sum()} vertex/vertices are in no triangle; K is NaN there: "
+            f"vertices {format_indices(np.flatnonzero(unreferenced))}"
+        )
+        deficit[unreferenced] = np.nan
+    return deficit
+
+
+def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=False):
+    """Pointwise Gaussian curvature ``K_i = (2 pi - sum_j theta_j) / A_i`` (n,) float64, in 1/length^2.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64
+    area : {"barycentric", "mixed"}
+        The vertex area ``A_i`` that turns the deficit into a pointwise value.
+    boundary : {"nan", "zero", "turning", "deficit"}
+        At boundary vertices (on an edge of one triangle) the deficit is not defined:
+
+        * ``"nan"`` (default): NaN; use ``np.nanmean`` etc.
+        * ``"zero"``: 0.
+        * ``"turning"``: the turning angle ``pi - sum theta``, the discrete
+          geodesic curvature of the boundary; then the integrated values sum
+          to ``2 pi chi`` exactly (Gauss-Bonnet with the boundary term). With
+          ``b`` boundary edges at the vertex (``b > 2`` at a "bow-tie") it is
+          ``2 pi - b pi / 2 - sum theta``, which keeps the identity.
+        * ``"deficit"``: the interior formula anyway, what a naive
+          implementation reports (about ``pi / A`` too large on a flat boundary).
+    integrated : bool
+        Return the (corrected) deficit in radians instead of dividing by ``A_i``.
+
+    Returns
+    -------
+    K : (n,) float64
+        NaN, with a MeshWarning, where ``A_i = 0`` (a vertex in no triangle of
+        non-zero area). Zero-area triangles count as flat. Edges of three or
+        more triangles count as interior edges (MeshWarning).
+        Meyer et al. 2003, section 4.
+    """
+    check_options(area=area)
+    if boundary not in BOUNDARY_RULES:
+        raise MeshError(f"boundary must be one of {BOUNDARY_RULES}, not {boundary!r}")
+    V, F = as_mesh(V, F)
+    K = angle_deficit(V, F)  # 2 pi - sum theta
+    if boundary != "deficit":
+        E, faces_at_edge = edge_face_counts(F, len(V))
+        b = np.bincount(E[faces_at_edge == 1].ravel(), minlength=len(V))  # boundary edges at each vertex
+        on_boundary = b > 0
+        if boundary == "turning":
+            K[on_boundary] -= 0.5 * np.pi * b[on_boundary]  # b = 2: pi - sum theta
+        else:
+            K[on_boundary] = np.nan if boundary == "nan" else 0.0
+        _warn_unusual_boundary(E[faces_at_edge > 2], on_boundary, boundary)
+    if integrated:
+        return K
+    A = vertex_areas(V, F, area)
+    if (A <= 0).any():
+        _warn(
+            f"{(A <= 0).sum()} vertex/vertices have zero area (in no triangle of non-zero area); "
+            f"K is NaN there: vertices {format_indices(np.flatnonzero(A <= 0))}"
+        )
+    return K / np.where(A > 0, A, np.nan)
+
+
+def _warn_unusual_boundary(non_manifold_edges, on_boundary, boundary):
+    if len(non_manifold_edges):
+        listed = ", ".join(f"({a}, {b})" for a, b in non_manifold_edges[:5].tolist())
+        more = f" (and {len(non_manifold_edges) - 5} more)" if len(non_manifold_edges) > 5 else ""
+        _warn(
+            f"{len(non_manifold_edges)} edge(s) belong to three or more triangles; they count as "
+            f"interior edges: {listed}{more}"
+        )
+    if on_boundary.all():
+        _warn(
+            f"every vertex of this mesh lies on the boundary; the angle deficit is defined nowhere "
+            f"(boundary={boundary!r} gives {'NaN everywhere' if boundary == 'nan' else 'the rule at every vertex'})"
+        )
+
+
+def principal_curvatures(H, K):
+    """Principal curvatures ``kappa_1 >= kappa_2`` (each (n,) float64) from signed H and K.
+
+    ``kappa_1,2 = H +- sqrt(H^2 - K)``. Where the discrete ``H^2 - K`` is
+    negative (impossible on a smooth surface, common for discrete estimates
+    near umbilics) it is clamped to 0, so ``kappa_1 = kappa_2 = H`` there.
+    Pass the signed H (``mean_curvature(..., signed=True)``); NaN in either
+    input gives NaN.
+    """
+    H = np.asarray(H, dtype=float)
+    K = np.asarray(K, dtype=float)
+    with np.errstate(invalid="ignore"):
+        root = np.sqrt(np.maximum(H * H - K, 0.0))
+    return H + root, H - root

@@ -1,0 +1,262 @@
+"""Lesson (notebooks 01 and 03): the discrete Laplace-Beltrami operator Delta = M^-1 C.
+
+The convention of the whole workbook:
+
+* ``C`` is symmetric, negative semidefinite, its rows sum to zero. Off the
+  diagonal ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)`` for the cotangent
+  operator (Pinkall and Polthier 1993; Meyer et al. 2003) and ``C_ij = 1`` for
+  the uniform (graph) operator, for every edge ij; ``C_ii = -sum_j C_ij``.
+* ``M`` is diagonal: the vertex area ``A_i`` for the cotangent operator (a
+  third of the incident triangle areas, or the mixed Voronoi area of Meyer et
+  al. 2003) and the valence for the uniform operator.
+* ``Delta = M^-1 C``, so that ``Delta x = -2 H n`` with ``n`` the outward unit
+  normal and ``H > 0`` on a sphere.
+
+Policy for bad triangles (never a NaN or an infinity in ``M`` or ``C``):
+
+* Zero-area triangles (``2 A <= ZERO_AREA_RTOL * longest edge^2``, the test of
+  :func:`geomlib.mesh.validate.is_zero_area`) have no angles. They add nothing to
+  the cotangent ``C`` or to ``M``, and a :class:`~geomlib.mesh.errors.MeshWarning`
+  names them. The uniform operator is combinatorial: their edges still count.
+* Needle triangles (small but non-zero area) keep their exact cotangents:
+  large (at most ``1 / ZERO_AREA_RTOL``) but finite. Clamping them would break
+  ``C x = 0`` for linear functions on flat regions.
+* A vertex in no triangle of non-zero area has a zero row in ``C`` and a zero
+  in ``M``: ``Delta`` is undefined there, and the functions that divide by
+  ``M`` say so.
+* A non-manifold edge (three or more triangles) gets the sum of all its
+  opposite cotangents: ``C`` stays a sum of per-triangle NSD matrices.
+"""
+
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..mesh.errors import MeshError, MeshWarning, format_indices
+from ..mesh.geometry import corner_positions, cross
+from ..mesh.topology import edges
+from ..mesh.validate import as_mesh, is_zero_area
+
+__all__ = [
+    "laplacian",
+    "uniform_laplacian",
+    "cotangent_matrix",
+    "cotangent_weights",
+    "vertex_areas",
+    "barycentric_areas",
+    "mixed_areas",
+    "face_geometry",
+    "uniform_adjacency",
+    "WEIGHTS",
+    "AREAS",
+]
+
+WEIGHTS = ("cotan", "uniform")
+AREAS = ("barycentric", "mixed")
+
+# the corners (j, k) that follow corner i = 0, 1, 2 counter-clockwise
+NEXT, PREV = [1, 2, 0], [2, 0, 1]
+
+
+def check_options(weights=None, area=None):
+    """Raise MeshError for a ``weights`` or ``area`` that geomlib does not know."""
+    if weights is not None and weights not in WEIGHTS:
+        raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
+    if area is not None and area not in AREAS:
+        raise MeshError(f"area must be 'barycentric' or 'mixed', not {area!r}")
+
+
+def face_geometry(V, F):
+    """Per face: squared edge lengths, twice the area, corner cotangents, zero-area flag.
+
+    Corner ``i`` of face ``(v0, v1, v2)`` sits opposite the edge ``e_i = v_k - v_j``
+    (``j, k`` the next two corners).
+
+    Returns
+    -------
+    l2 : (m, 3) float64
+        ``l2[f, i] = |e_i|^2`` (length^2).
+    dblA : (m,) float64
+        ``2 A_f = |(v1 - v0) x (v2 - v0)|`` (length^2).
+    cot : (m, 3) float64
+        ``cot theta_i = <e_j, -e_k> / 2A = (l_j^2 + l_k^2 - l_i^2) / (4 A)``
+        (law of cosines over the cross product); 0 on zero-area faces.
+    degenerate : (m,) bool
+        Zero-area faces (:func:`geomlib.mesh.validate.is_zero_area`).
+    """
+    V, F = as_mesh(V, F)
+    v0, v1, v2 = corner_positions(V, F)  # (3, m) coordinate rows of each corner
+    e = (v2 - v1, v0 - v2, v1 - v0)  # e_i = v_k - v_j, the edge opposite corner i
+    l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])  # |e_i|^2, (3, m)
+    N2 = cross(e[1], e[2])  # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
+    dblA = np.sqrt(np.einsum("cf,cf->f", N2, N2))
+    degenerate = is_zero_area(dblA, l2.max(axis=0))
+    cot = (l2.sum(axis=0) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))
+    cot[:, degenerate] = 0.0
+    # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
+    return l2.T, dblA, cot.T, degenerate
+
+
+def warn_zero_area(degenerate):
+    """One MeshWarning naming the zero-area faces, if there are any."""
+    if degenerate.any():
+        idx = np.flatnonzero(degenerate)
+        warnings.warn(
+            f"{len(idx)} zero-area triangle(s) contribute nothing to the cotangent Laplacian "
+            f"and the vertex areas: faces {format_indices(idx)}",
+            MeshWarning,
+            stacklevel=3,
+        )
+
+
+def uniform_laplacian(V, F):
+    """(M, C) of the uniform (graph) Laplacian: C_ij = 1 on every edge, C_ii = -valence, M = diag(valence).
+
+    C is symmetric, NSD, rows sum to zero; ``M^-1 C x`` is the mean of the
+    neighbours minus ``x_i`` (the "umbrella" operator, Taubin 1995). No metric:
+    zero-area faces count like any other.
+
+    Returns
+    -------
+    M : (n, n) scipy.sparse DIA float64, the valences
+    C : (n, n) scipy.sparse CSR float64
+    """
+    V, F = as_mesh(V, F)
+    n = len(V)
+    E = edges(F)  # each edge ij once, i < j
+    ones = np.ones(len(E))
+    adjacency = sp.coo_matrix(
+        (np.r_[ones, ones], (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])), shape=(n, n)
+    ).tocsr()
+    valence = np.diff(adjacency.indptr).astype(np.float64)
+    C = (adjacency - sp.diags(valence)).tocsr()
+    C.sort_indices()
+    return sp.diags(valence), C
+
+
+def cotangent_matrix(V, F):
+    """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
+
+    Triangle ``(v0, v1, v2)`` adds ``1/2 cot theta_i`` to the edge ``(j, k)``
+    opposite its corner i. A boundary edge has one triangle, so one angle:
+    ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
+    Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
+    """
+    V, F = as_mesh(V, F)
+    n = len(V)
+    _, _, cot, degenerate = face_geometry(V, F)
+    warn_zero_area(degenerate)
+    index = np.int32 if n < 2**31 - 1 else np.int64
+    j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
+    w = 0.5 * cot.T.ravel()  # gets 1/2 cot theta_i
+    diagonal = -(np.bincount(j, w, minlength=n) + np.bincount(k, w, minlength=n))  # rows sum to zero
+    d = np.arange(n, dtype=index)
+    rows, cols = np.concatenate([j, k, d]), np.concatenate([k, j, d])
+    return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
+
+
+def barycentric_areas(V, F):
+    """(n,) vertex areas A_i in length^2: a third of the area of every incident triangle.
+
+    Zero-area triangles add 0 (MeshWarning), so a vertex in no other triangle
+    has area 0. Sums to the surface area.
+    """
+    V, F = as_mesh(V, F)
+    _, dblA, _, degenerate = face_geometry(V, F)
+    warn_zero_area(degenerate)
+    third = np.where(degenerate, 0.0, dblA / 6.0)
+    return np.bincount(F.T.ravel(), np.tile(third, 3), minlength=len(V))
+
+
+def mixed_areas(V, F):
+    """(n,) mixed Voronoi vertex areas A_i in length^2 (Meyer et al. 2003, Fig. 4).
+
+    Per triangle and corner i (j, k the other two corners, A the triangle area):
+
+    * no obtuse angle: the Voronoi part ``1/8 (|e_j|^2 cot theta_j + |e_k|^2 cot theta_k)``,
+      the two edges at i weighted by the cotangents of the angles opposite them;
+    * obtuse at i: ``A / 2`` (the Voronoi region would leave the triangle);
+    * obtuse at another corner: ``A / 4``.
+
+    Sums to the surface area. Zero-area triangles add 0 (MeshWarning).
+    """
+    V, F = as_mesh(V, F)
+    l2, dblA, cot, degenerate = face_geometry(V, F)
+    warn_zero_area(degenerate)
+    A = 0.5 * dblA[:, None]
+    lc = l2 * cot
+    voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
+    obtuse = cot < 0  # cot theta < 0 <=> theta > pi/2
+    obtuse_triangle = obtuse.any(axis=1, keepdims=True)
+    per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
+    per_corner[degenerate] = 0.0
+    return np.bincount(F.T.ravel(), per_corner.T.ravel(), minlength=len(V))
+
+
+def vertex_areas(V, F, area="barycentric"):
+    """(n,) vertex areas A_i in length^2, the diagonal of the cotangent M.
+
+    ``area="barycentric"``: :func:`barycentric_areas`; ``"mixed"``:
+    :func:`mixed_areas` (Meyer et al. 2003). Both sum to the surface area.
+    """
+    check_options(area=area)
+    return barycentric_areas(V, F) if area == "barycentric" else mixed_areas(V, F)
+
+
+def laplacian(V, F, weights="cotan", area="barycentric"):
+    """The Laplace-Beltrami operator ``Delta = M^-1 C`` as the pair (M, C); C is NSD.
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+        Vertex positions.
+    F : (m, 3) int64
+        Triangles, counter-clockwise seen from outside.
+    weights : {"cotan", "uniform"}
+        :func:`cotangent_matrix` with vertex areas, or :func:`uniform_laplacian`
+        (then ``area`` is ignored and M holds the valences).
+    area : {"barycentric", "mixed"}
+        The vertex areas of M (:func:`vertex_areas`).
+
+    Returns
+    -------
+    M : (n, n) scipy.sparse DIA float64
+    C : (n, n) scipy.sparse CSR float64
+        Symmetric, negative semidefinite, rows summing to zero. With this sign
+        ``Delta x = -2 H n`` for the outward unit normal n, H > 0 on a sphere.
+
+    Raises
+    ------
+    MeshError
+        Unknown ``weights`` or ``area``; malformed V or F (:func:`geomlib.mesh.validate.as_mesh`).
+
+    Notes
+    -----
+    Boundary edges have one triangle and get ``1/2 cot alpha``: the operator
+    with natural (Neumann) boundary conditions. See the module docstring for
+    zero-area and needle triangles and isolated vertices.
+    Pinkall and Polthier 1993; Desbrun et al. 1999; Meyer et al. 2003.
+    """
+    check_options(weights, area)
+    V, F = as_mesh(V, F)
+    if weights == "uniform":
+        return uniform_laplacian(V, F)
+    C = cotangent_matrix(V, F)  # names the zero-area faces, if any
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshWarning)  # the same faces: named once is enough
+        M = sp.diags(vertex_areas(V, F, area))
+    return M, C
+
+
+def cotangent_weights(V, F):
+    """The cotangent matrix C (n, n); the name the package exports for :func:`cotangent_matrix`."""
+    return cotangent_matrix(V, F)
+
+
+def uniform_adjacency(n, F):
+    """Adjacency matrix (n, n) CSR float64 with 1 for every edge ij (each edge once, both directions)."""
+    M, C = uniform_laplacian(np.zeros((n, 3)), F)
+    A = (C + M).tocsr()
+    A.eliminate_zeros()
+    return A

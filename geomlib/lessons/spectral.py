@@ -1,0 +1,337 @@
+"""Eigenvectors of the Laplace-Beltrami operator and spectral reconstruction (notebook 04).
+
+Convention: the eigenpairs ``(lam_i, e_i)`` solve the symmetric generalised
+problem ``C e = -lam M e`` with ``(M, C)`` from :func:`geomlib.laplacian`
+(``C`` symmetric negative semidefinite, ``M`` diagonal vertex areas), so
+``Delta e = M^-1 C e = -lam e`` with ``lam >= 0``: ``lam`` is a squared
+spatial frequency in 1/length^2 (on the unit sphere ``lam -> l (l + 1)``).
+Eigenvalues come in ascending order; the eigenvectors are orthonormal in the
+``M`` inner product, ``E^T M E = I`` (not ``E^T E = I``: they are samples of
+functions normalised by the integral ``int e^2 dA = 1``). The first one is the
+constant ``1 / sqrt(area)`` with ``lam = 0``; a mesh with ``c`` connected
+components has ``c`` zero eigenvalues, one per component, and their
+eigenvectors are the normalised indicator functions of the components
+(largest area first); each component then has its own spectrum.
+
+How it is solved (:func:`eigenbasis`): ``M^-1 C`` is not symmetric, so with
+``D = M^1/2`` the problem becomes ``S y = lam y``, ``S = -D^-1 C D^-1``,
+``e = D^-1 y`` (Vallet and Levy 2008), handed to
+:func:`geomlib.numerics.eigen.smallest_eigenpairs` (dense LAPACK for small meshes,
+ARPACK shift-invert Lanczos on one sparse Cholesky factorisation otherwise).
+
+Cache (:mod:`geomlib.numerics.cache`): a basis is kept in memory (the last few meshes)
+and on disk, so a slider over ``k`` re-projects without solving again and a
+restarted kernel finds it. ``cache=False`` neither reads nor writes it;
+:func:`clear_spectral_cache` empties it; :func:`spectral_cache_dir` says where
+it is.
+"""
+
+import hashlib
+import time
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..mesh.errors import MeshError, MeshWarning
+from ..mesh.requirements import positive_vertex_areas
+from ..mesh.topology import connected_components
+from ..mesh.validate import as_mesh
+from ..numerics import cache as basis_cache
+from ..numerics.eigen import one_blas_thread, smallest_eigenpairs
+from .laplace import laplacian
+
+__all__ = [
+    "eigenbasis",
+    "spectral_reconstruction",
+    "SpectralBasis",
+    "spectral_basis",
+    "spectral_cache_dir",
+    "clear_spectral_cache",
+]
+
+_METHODS = {"auto": "auto", "dense": "dense", "sparse": "sparse", "arpack": "sparse"}
+
+
+def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=None):
+    """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
+
+    ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
+    Solved in the symmetric form ``S y = lam y`` with ``S = -M^-1/2 C M^-1/2``
+    and ``e = M^-1/2 y`` (Vallet and Levy 2008): dense LAPACK for small meshes,
+    ARPACK shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) on one sparse
+    Cholesky factorisation otherwise (:mod:`geomlib.numerics.eigen`).
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64
+    k : int, 1 <= k <= n
+        Number of eigenpairs.
+    weights, area : as in :func:`geomlib.laplacian`.
+    cache : bool
+        Read and write the memory and disk cache (:mod:`geomlib.numerics.cache`); with
+        ``cache=False`` the basis is always solved for and not stored.
+    cache_dir : str or Path, optional
+        Cache folder for this call (default: :func:`spectral_cache_dir`).
+    method : "auto", "dense", "sparse" or "arpack"
+        "auto" is "dense" (LAPACK) up to ``geomlib.numerics.eigen.DENSE_MAX`` vertices or
+        when k is more than a third of n, "sparse" otherwise; "arpack" is
+        another name for "sparse".
+    tol : float or None
+        ARPACK's relative accuracy of the eigenvalues (default: machine precision).
+
+    Returns
+    -------
+    lam : (k,) float64
+        Eigenvalues in 1/length^2, ascending; ``lam[0] == 0`` exactly (one
+        zero per connected component).
+    E : (n, k) float64
+        Eigenvectors as columns, ``E^T M E = I``; the first is the constant
+        ``1/sqrt(area)``; on several components the first ones are the
+        components' normalised indicator functions, largest area first. Each
+        other column's entry of largest magnitude is positive. Within a
+        repeated eigenvalue (e.g. a sphere's 2l + 1 fold ones) any M-orthonormal
+        basis of the eigenspace is a correct answer.
+
+    Raises
+    ------
+    MeshError
+        k not an integer, k < 1 or k > n; unknown method; vertices with zero
+        vertex area (used by no face, or only by zero-area faces), named, with
+        the call that removes them.
+
+    Warns
+    -----
+    MeshWarning
+        Several connected components (several zero eigenvalues).
+
+    Notes
+    -----
+    Boundaries need nothing special: the cotangent operator of an open mesh
+    gives the natural (Neumann) boundary condition, so the constant is still
+    the first eigenvector.
+    """
+    if cache:  # a basis stored by an earlier call, or this function's result, stored
+        basis = spectral_basis(V, F, k, weights, area, cache_dir=cache_dir, method=method, tol=tol)
+        return basis.lam.copy(), basis.E.copy(order="F")
+    V, F = as_mesh(V, F)
+    k, method = _check_k(k, len(V)), _check_method(method)
+    M, C = laplacian(V, F, weights=weights, area=area)
+    m = positive_vertex_areas(M, F, "eigenbasis")
+    D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
+    S = D_inv @ (-C) @ D_inv  # symmetric PSD: S y = lam y
+    shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
+    lam, Y = smallest_eigenpairs(S.tocsr(), k, shift, _METHODS[method], tol or 0.0)
+    E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
+    return _tidy(lam, E, m, F)
+
+
+def _check_k(k, n):
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+        raise MeshError(f"k must be an integer number of eigenpairs, not {k!r}")
+    k = int(k)
+    if k < 1:
+        raise MeshError(f"k must be at least 1, not {k}")
+    if k > n:
+        raise MeshError(
+            f"k = {k} eigenpairs asked for, but the mesh has only {n} vertices (at most n = {n} eigenpairs exist)"
+        )
+    return k
+
+
+def _check_method(method):
+    if method not in _METHODS:
+        raise MeshError(f"method must be 'auto', 'dense', 'sparse' or 'arpack', not {method!r}")
+    return method
+
+
+def _components(F, m):
+    """Component label per vertex, numbered by area, largest first (ties: smallest vertex index)."""
+    labels = connected_components(F, len(m))
+    count = labels.max() + 1
+    size = np.bincount(labels, weights=m, minlength=count)
+    rank = np.empty(count, dtype=np.int64)
+    rank[np.lexsort((np.arange(count), -size))] = np.arange(count)  # labels follow the first vertex
+    return count, rank[labels]
+
+
+def _tidy(lam, E, m, F):
+    """Exact zeros and indicator functions for the null space, M-normalised columns, fixed signs."""
+    lam = np.array(lam, dtype=np.float64)
+    E = np.asfortranarray(E)
+    E /= np.sqrt(np.einsum("ij,i,ij->j", E, m, E))[None, :]  # Y^T Y = I only to rounding
+    count, labels = _components(F, m)
+    if count > 1:
+        warnings.warn(
+            f"the mesh has {count} connected components: the first {count} eigenvalues are 0 "
+            f"and their eigenvectors are the components' indicator functions; each component "
+            f"has its own spectrum",
+            MeshWarning,
+            stacklevel=3,
+        )
+    c = min(count, len(lam))
+    # The solver returns some rotation of the null space (rounding decides which):
+    # replace it by the normalised indicator function of each component.
+    scale = max(abs(lam[-1]), 4.0 * np.pi / m.sum())
+    if np.all(np.abs(lam[:c]) <= 1e-8 * scale):
+        areas = np.bincount(labels, weights=m, minlength=count)[:c]
+        E[:, :c] = (labels[:, None] == np.arange(c)[None, :]) / np.sqrt(areas)[None, :]
+        lam[:c] = 0.0
+    lam = np.maximum(lam, 0.0)  # -C is positive semidefinite; rounding can dip below zero
+    big = np.argmax(np.abs(E), axis=0)  # sign: the entry of largest magnitude is positive
+    E *= np.where(E[big, np.arange(len(lam))] < 0, -1.0, 1.0)[None, :]
+    return lam, E
+
+
+class SpectralBasis:
+    """The first k Laplace-Beltrami eigenpairs of a mesh, ready to project onto.
+
+    Convention: ``C e = -lam M e``, ``lam`` ascending >= 0, ``E^T M E = I``.
+    Made by :func:`spectral_basis`. Projections use the ``M`` inner product
+    ``<f, g>_M = f^T M g`` (the discrete ``int f g dA``).
+
+    Attributes
+    ----------
+    lam : (k,) float64, 1/length^2
+    E : (n, k) float64, Fortran order (the first j columns are one block)
+    m : (n,) float64 diagonal of M, length^2
+    components : int, zero eigenvalues among the k (the connected components when k reaches them)
+    seconds : float, time the solve took (0 when it came from the cache)
+    source : "solved", "memory" or "disk"
+    """
+
+    def __init__(self, lam, E, m, components=1, seconds=0.0, source="solved"):
+        self.lam, self.E, self.m = lam, E, m
+        self.components, self.seconds, self.source = components, seconds, source
+        self._coefficients = {}
+
+    @property
+    def k(self):
+        return len(self.lam)
+
+    def __repr__(self):
+        return (
+            f"SpectralBasis(n={self.E.shape[0]}, k={self.k}, components={self.components}, "
+            f"lam=[{self.lam[0]:.3g} .. {self.lam[-1]:.3g}], source={self.source!r})"
+        )
+
+    def _k(self, k):
+        if k is None:
+            return self.k
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= self.k:
+            raise MeshError(f"k must be an integer in 1..{self.k} (the eigenpairs in this basis), not {k!r}")
+        return int(k)
+
+    def coefficients(self, X):
+        """Spectral coefficients ``E^T M X`` (k, ...) of per-vertex values X (n,) or (n, d).
+
+        Remembered for the last few X (by content), so a slider over k only multiplies.
+        """
+        X = np.asarray(X, dtype=np.float64)
+        if X.shape[0] != self.E.shape[0]:
+            raise MeshError(f"X has {X.shape[0]} rows but the basis has {self.E.shape[0]} vertices")
+        h = (hashlib.blake2b(np.ascontiguousarray(X).view(np.uint8), digest_size=16).hexdigest(), X.shape)
+        c = self._coefficients.get(h)
+        if c is None:
+            c = self.E.T @ (self.m.reshape((-1,) + (1,) * (X.ndim - 1)) * X)
+            if len(self._coefficients) >= 4:
+                self._coefficients.pop(next(iter(self._coefficients)))
+            self._coefficients[h] = c
+        return c
+
+    def reconstruct(self, X, k=None):
+        """``E_k E_k^T M X``: the M-orthogonal projection of X onto the first k eigenvectors."""
+        k = self._k(k)
+        with one_blas_thread():  # see geomlib.numerics.eigen: a 2-thread pool on a busy 2-core machine is slower
+            return self.E[:, :k] @ self.coefficients(X)[:k]
+
+    def residual_norms(self, X):
+        """``||X - X_k||_M`` for k = 1 .. self.k, from the coefficients alone (Parseval).
+
+        X (n,) or (n, d); the norm is ``sqrt(sum_i m_i |x_i - x_k,i|^2)`` in
+        length * sqrt(area), summed over the d columns. Returns (k,).
+        """
+        X = np.asarray(X, dtype=np.float64)
+        c = self.coefficients(X).reshape(self.k, -1)
+        Xf = X.reshape(len(self.m), -1)
+        total = float(np.einsum("i,ij,ij->", self.m, Xf, Xf))
+        return np.sqrt(np.maximum(total - np.cumsum((c * c).sum(axis=1)), 0.0))
+
+
+def spectral_basis(
+    V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=None
+):
+    """The first k eigenpairs as a :class:`SpectralBasis` (cached; see :func:`eigenbasis`).
+
+    ``basis.reconstruct(X, j)`` then projects per-vertex values X onto the
+    first j <= k eigenvectors without solving again (what a slider over k
+    needs); ``basis.residual_norms(X)`` gives the error for every j at once.
+    A stored basis with more than k eigenpairs serves the request.
+    """
+    V, F = as_mesh(V, F)
+    basis = _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol)
+    if basis.k == k:
+        return basis
+    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0, basis.source)
+
+
+def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
+    """The basis in memory, on disk or solved, with at least k eigenpairs (V, F validated)."""
+    k, method = _check_k(k, len(V)), _check_method(method)
+    name = basis_cache.key(V, F, weights, area) if cache else None
+    basis = basis_cache.recall(name) if cache else None
+    if basis is None or basis.k < k:
+        basis = _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name)
+    return basis
+
+
+def _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name):
+    folder = spectral_cache_dir(cache_dir)
+    stored = basis_cache.load(folder, name, k) if cache else None
+    t0 = time.perf_counter()
+    if stored is None:
+        lam, E = eigenbasis(V, F, k, weights, area, cache=False, method=method, tol=tol)
+        source = "solved"
+    else:
+        (lam, E), source = stored, "disk"
+    M, _ = laplacian(V, F, weights=weights, area=area)
+    m = positive_vertex_areas(M, F, "spectral_basis")
+    seconds = time.perf_counter() - t0 if source == "solved" else 0.0
+    basis = SpectralBasis(lam, E, m, int((lam == 0).sum()), seconds, source)
+    if cache:
+        if source == "solved":
+            basis_cache.store(folder, name, lam, E)
+        basis_cache.remember(name, basis)
+    return basis
+
+
+def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto"):
+    """``V_k = E (E^T M V)``: the coordinates projected onto the first k eigenvectors.
+
+    The projection is orthogonal in the M inner product (``<f, g>_M = f^T M g``,
+    the discrete ``int f g dA``), the one in which the eigenvectors are
+    orthonormal; ``k = n`` gives back V to rounding. With ``cache=True`` a
+    repeated call with another k only multiplies.
+
+    Returns
+    -------
+    V_k : (n, 3) float64, in the units of V.
+    """
+    if cache:  # the basis of an earlier call: another k only multiplies
+        V, F = as_mesh(V, F)
+        return _stored_basis(V, F, k, weights, area, True, cache_dir, method, None).reconstruct(V, int(k))
+    V, F = as_mesh(V, F)
+    M, _ = laplacian(V, F, weights=weights, area=area)
+    lam, E = eigenbasis(V, F, k, weights, area, cache=False, method=method)
+    return E @ (E.T @ (M @ V))
+
+
+def spectral_cache_dir(cache_dir=None):
+    """The folder holding cached eigenbases (it need not exist yet); see :func:`geomlib.numerics.cache.folder`."""
+    return basis_cache.folder(cache_dir)
+
+
+def clear_spectral_cache(cache_dir=None, memory=True):
+    """Delete the cached eigenbases on disk (and in memory); returns the number of files removed."""
+    return basis_cache.clear(cache_dir, memory)

@@ -1,0 +1,120 @@
+"""Elementary measurements of a triangle mesh: one home for each.
+
+Machinery shared by the lessons, the metrics, the smoothers and the viewer:
+face normals and areas, total area, enclosed volume, bounding-box diagonal,
+mean edge length. Inputs are validated by ``validate.as_mesh``; lengths are in
+the mesh's own units.
+"""
+
+import numpy as np
+
+from .topology import edges
+from .validate import ZERO_AREA_RTOL, as_faces, as_mesh, as_vertices, is_zero_area
+
+__all__ = [
+    "corner_positions",
+    "cross",
+    "face_cross",
+    "face_areas",
+    "face_normals",
+    "zero_area_faces",
+    "vertex_normals",
+    "surface_area",
+    "enclosed_volume",
+    "bounding_box_diagonal",
+    "mean_edge_length",
+]
+
+
+def corner_positions(V, F):
+    """(3, 3, m) float64: ``P[i]`` holds the (x, y, z) rows of corner i of every face (unchecked input).
+
+    Corner-major, coordinate rows: each row is contiguous, which makes the
+    per-face formulas below and in geomlib.lessons.laplace fast.
+    """
+    return np.ascontiguousarray(V.T).take(F.T, axis=1).swapaxes(0, 1)
+
+
+def cross(a, b):
+    """Cross product of (3, m) coordinate rows, written out (several times faster than ``np.cross``)."""
+    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def face_cross(V, F):
+    """(m, 3) float64: ``(v1 - v0) x (v2 - v0)`` per face, which is 2 A_f n_f (unchecked input)."""
+    v0, v1, v2 = corner_positions(V, F)
+    return cross(v1 - v0, v2 - v0).T
+
+
+def zero_area_faces(V, F, rtol=ZERO_AREA_RTOL):
+    """Indices (k,) int64 of the faces whose area is zero up to rounding (:func:`geomlib.mesh.validate.is_zero_area`).
+
+    Faces with a repeated vertex never reach here (``validate.as_mesh`` refuses them).
+    """
+    V, F = as_mesh(V, F)
+    v0, v1, v2 = corner_positions(V, F)
+    dblA = np.sqrt((cross(v1 - v0, v2 - v0) ** 2).sum(axis=0))
+    longest2 = np.max(
+        [((v1 - v0) ** 2).sum(axis=0), ((v2 - v1) ** 2).sum(axis=0), ((v0 - v2) ** 2).sum(axis=0)], axis=0
+    )
+    return np.flatnonzero(is_zero_area(dblA, longest2, rtol))
+
+
+def face_areas(V, F):
+    """(m,) float64: triangle areas A_f = |(v1 - v0) x (v2 - v0)| / 2 (length^2)."""
+    V, F = as_mesh(V, F)
+    return 0.5 * np.linalg.norm(face_cross(V, F), axis=1)
+
+
+def face_normals(V, F):
+    """(m, 3) float64: unit face normals, right-handed in the corner order (outward for CCW faces).
+
+    A zero-area face has no normal: its row is (0, 0, 0), not NaN.
+    """
+    V, F = as_mesh(V, F)
+    N = face_cross(V, F)
+    length = np.linalg.norm(N, axis=1, keepdims=True)
+    return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
+
+
+def vertex_normals(V, F):
+    """(n, 3) float64: area-weighted unit vertex normals, outward for CCW faces.
+
+    The normalised sum of the incident faces' ``2 A_f n_f``. A vertex in no
+    face of non-zero area has no normal: its row is (0, 0, 0), not NaN.
+    """
+    V, F = as_mesh(V, F)
+    N2 = face_cross(V, F)
+    N = np.stack([np.bincount(F.ravel(), np.repeat(N2[:, k], 3), minlength=len(V)) for k in range(3)], axis=1)
+    length = np.linalg.norm(N, axis=1, keepdims=True)
+    return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
+
+
+def surface_area(V, F):
+    """Total area of the triangles (length^2)."""
+    return float(face_areas(V, F).sum())
+
+
+def enclosed_volume(V, F):
+    """Signed enclosed volume ``1/6 sum_f v0 . (v1 x v2)`` (length^3), by the divergence theorem.
+
+    Positive for a closed mesh whose faces are counter-clockwise seen from
+    outside; on an open mesh it depends on the origin (not checked here).
+    """
+    V, F = as_mesh(V, F)
+    v0, v1, v2 = corner_positions(V, F)
+    return float(np.einsum("cf,cf->", v0, cross(v1, v2)) / 6.0)
+
+
+def bounding_box_diagonal(V):
+    """Length of the diagonal of the axis-aligned bounding box, ``|max(V) - min(V)|`` (length)."""
+    V = as_vertices(V)
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+def mean_edge_length(V, F):
+    """Mean length of the mesh's edges, each edge counted once (length)."""
+    V = as_vertices(V)
+    F = as_faces(F, len(V))
+    E = edges(F)
+    return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())

@@ -1,0 +1,272 @@
+"""Checks of the exercises of notebook 07: the noise model and the vertex RMS error.
+
+``add_noise(fn)`` checks ``fn(V, F, sigma, seed) -> V'``: Gaussian noise with
+standard deviation ``s = sigma * d`` per coordinate, ``d`` the bounding-box
+diagonal of V, independent per vertex and coordinate, seeded, V untouched.
+Noise is random, so this check is statistical: it measures the noise on a
+regular grid of 2,400 vertices (7,200 numbers; the standard deviation is then
+known to about 1 %) and accepts a standard deviation within 6 % of ``s``.
+The wrong scalings it recognises are far apart on purpose: the grid is
+chosen so that d, the mean edge length ell and 1 differ by large factors.
+
+``vertex_rms(fn)`` checks ``fn(V, V_clean) -> float``:
+``sqrt(mean_i |x_i - x_i^clean|^2) / d_clean`` on cases with exact answers.
+"""
+
+import numpy as np
+
+from ...mesh.geometry import bounding_box_diagonal, mean_edge_length
+from .result import Mistake, call, exercise
+
+__all__ = ["add_noise", "vertex_rms"]
+
+NOISE_SECTION = "section 2 · The noise model"
+RMS_SECTION = "section 3 · The metrics"
+
+
+def _grid(nx, ny, spacing, height):
+    """A regular grid of nx x ny vertices (spacing apart) on a tilted plane, two triangles per cell."""
+    x, y = np.meshgrid(np.arange(nx) * spacing, np.arange(ny) * spacing)
+    V = np.column_stack([x.ravel(), y.ravel(), height * x.ravel() / x.max()])
+    i = np.arange(nx * ny).reshape(ny, nx)
+    a, b, c, d = i[:-1, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, 1:].ravel(), i[1:, :-1].ravel()
+    F = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return V, F
+
+
+# 60 x 40 vertices, 5 length units apart: d = 351, ell = 6.0, so the wrong scalings are far apart
+_NOISE_V, _NOISE_F = _grid(60, 40, 5.0, 50.0)
+_SIGMA, _SEED = 0.02, 3
+_STD_TOLERANCE = 0.06
+
+
+def _array(out, n, what):
+    if not isinstance(out, np.ndarray):
+        raise Mistake(
+            f"{what} returned {type(out).__name__}, not a numpy array of positions",
+            "return V + noise, an (n, 3) numpy array",
+        )
+    if out.shape != (n, 3):
+        raise Mistake(
+            f"{what} returned shape {out.shape}, expected ({n}, 3): one position per vertex",
+            "add an (n, 3) array of noise to V",
+        )
+    return out.astype(float)
+
+
+def _scale_mistakes(d, ell, sigma):
+    """The standard deviation each typical wrong scaling gives, with its diagnosis and hint."""
+    s = sigma * d
+    return [
+        (
+            sigma,
+            "the noise is not scaled by the bounding box: its standard deviation is sigma itself",
+            "sigma is a fraction of the bounding-box diagonal d; multiply the unit noise by s = sigma * d",
+        ),
+        (
+            sigma * ell,
+            "the noise is scaled by the mean edge length instead of the bounding-box diagonal",
+            "s = sigma * d with d = |max(V) - min(V)|, the bounding-box diagonal",
+        ),
+        (
+            sigma**2 * d,
+            "sigma is used as a variance: the standard deviation came out as sigma^2 * d",
+            "sigma is the standard deviation; draw standard normals and multiply by sigma * d",
+        ),
+        (
+            s**2,
+            "the variance s^2 is used where the standard deviation s belongs",
+            "multiply standard normal numbers by s = sigma * d, not by s^2",
+        ),
+        (
+            np.sqrt(s),
+            "the square root of s is used: sigma * d was taken as a variance",
+            "the standard deviation is s = sigma * d itself",
+        ),
+        (
+            s / np.sqrt(3),
+            "each displacement has length about s (a random direction scaled to s), so each "
+            "coordinate moves by only s / sqrt(3)",
+            "draw each of the three coordinates independently with standard deviation s",
+        ),
+    ]
+
+
+@exercise("add_noise", reread=NOISE_SECTION)
+def add_noise(fn):
+    """Check ``fn(V, F, sigma, seed) -> V'``: V + sigma * d * (independent standard normals)."""
+    V, F = _NOISE_V, _NOISE_F
+    n = len(V)
+    d, ell = bounding_box_diagonal(V), mean_edge_length(V, F)
+    V_in = V.copy()
+    out = call(fn, V_in, F.copy(), _SIGMA, _SEED)
+    if out is V_in:
+        raise Mistake(
+            "the function returned the array it was given: V was modified in place",
+            "work on a copy: return V + noise, never V += noise",
+        )
+    out = _array(out, n, "the function")
+    if not np.array_equal(V_in, V):
+        raise Mistake(
+            "V was modified in place (the caller's clean mesh changed)",
+            "return a new array, V + noise, and leave V as it was",
+        )
+    again = _array(call(fn, V.copy(), F.copy(), _SIGMA, _SEED), n, "a second call")
+    if not np.array_equal(out, again):
+        raise Mistake(
+            "two calls with the same seed gave different noise: it is not seeded (not reproducible)",
+            "draw from rng = np.random.default_rng(seed), not from np.random directly",
+        )
+    other = _array(call(fn, V.copy(), F.copy(), _SIGMA, _SEED + 1), n, "a call with another seed")
+    if np.array_equal(out, other):
+        raise Mistake(
+            "another seed gave the same noise: the seed is ignored", "pass the seed to np.random.default_rng(seed)"
+        )
+    zero = _array(call(fn, V.copy(), F.copy(), 0.0, _SEED), n, "the call with sigma = 0")
+    D = out - V
+    if np.allclose(D, D[0], rtol=0, atol=1e-12 * d) and not np.allclose(D, 0):
+        raise Mistake(
+            "every vertex moved by the same vector: the whole mesh was shifted, not made noisy",
+            "draw an (n, 3) array of noise, one independent vector per vertex",
+        )
+    if not np.allclose(zero, V, rtol=0, atol=1e-12 * d):
+        raise Mistake("sigma = 0 still moved the vertices", "the noise must be sigma * d times the unit noise")
+    if np.allclose(D, 0):
+        raise Mistake("the vertices did not move", "add the noise to V and return the result")
+    std = float(D.std())
+    mean = D.mean(axis=0)
+    if np.any(np.abs(mean) > 5 * std / np.sqrt(n)):
+        raise Mistake(
+            f"the noise is not centred: its mean is {np.round(mean / std, 2)} standard deviations",
+            "use standard normal numbers (mean 0), e.g. rng.standard_normal((n, 3))",
+        )
+    per_axis = D.std(axis=0) / std
+    if np.any(np.abs(per_axis - 1) > _STD_TOLERANCE):
+        raise Mistake(
+            f"the coordinates are not equally noisy (standard deviations x, y, z in the ratio {np.round(per_axis, 2)})",
+            "every coordinate of every vertex gets its own standard normal number times s",
+        )
+    s = _SIGMA * d
+    if abs(std / s - 1) > _STD_TOLERANCE:
+        for wrong, diagnosis, hint in _scale_mistakes(d, ell, _SIGMA):
+            if abs(std / wrong - 1) <= _STD_TOLERANCE:
+                raise Mistake(diagnosis, hint)
+        raise Mistake(
+            f"the noise has standard deviation {std:.3g} per coordinate, expected s = sigma * d = "
+            f"{_SIGMA:g} * {d:.4g} = {s:.4g} (within {_STD_TOLERANCE:.0%})",
+            "multiply standard normal numbers by sigma times the bounding-box diagonal of V",
+        )
+    z = (D / std).ravel()
+    kurtosis = float(np.mean(z**4))
+    if kurtosis < 2.5:
+        raise Mistake(
+            f"the noise is not Gaussian (kurtosis {kurtosis:.2f}; a normal distribution has 3, a uniform one 1.8)",
+            "use rng.standard_normal, not rng.random or rng.uniform",
+        )
+    return [
+        f"a {n}-vertex grid (s = sigma * d within {_STD_TOLERANCE:.0%}, centred, Gaussian, independent per vertex)",
+        "reproducibility with a seed",
+        "V left unchanged",
+        "sigma = 0",
+    ]
+
+
+# a tetrahedron with one vertex moved by 3 (exact answer 1.5 / d) and a lopsided displacement field
+_TET = np.array([[0.0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]])
+
+
+def _rms_cases():
+    moved = _TET.copy()
+    moved[1, 0] += 3.0  # also widens the noisy bounding box
+    grid, _ = _grid(7, 5, 1.0, 2.0)
+    rng = np.random.default_rng(5)
+    bumped = grid + rng.standard_normal(grid.shape) * np.linspace(0.05, 1.5, len(grid))[:, None]
+    return [
+        ("a tetrahedron with one vertex moved by 3", moved, _TET),
+        ("a grid with displacements of very different sizes", bumped, grid),
+        ("a mesh compared with itself", grid.copy(), grid),
+    ]
+
+
+def _rms_mistakes(V, V_clean):
+    e2 = np.einsum("ij,ij->i", V - V_clean, V - V_clean)
+    d, d_noisy = bounding_box_diagonal(V_clean), bounding_box_diagonal(V)
+    rms = np.sqrt(e2.mean())
+    return [
+        (
+            rms,
+            "the result is not relative: it is in length units, not divided by the bounding-box diagonal",
+            "divide by d, the bounding-box diagonal of the clean mesh",
+        ),
+        (
+            np.sqrt(e2).mean() / d,
+            "this is the mean of the distances, not the root of the mean square",
+            "square each distance, average, then take the square root",
+        ),
+        (
+            e2.mean() / d,
+            "the mean squared error is not rooted",
+            "take the square root of the mean of |x_i - x_i^clean|^2",
+        ),
+        (
+            e2.mean() / d**2,
+            "the mean squared error is not rooted (this is RMS^2)",
+            "take the square root of the mean before comparing",
+        ),
+        (
+            np.sqrt(e2.sum()) / d,
+            "the squared distances are summed, not averaged",
+            "divide the sum by the number of vertices n before the square root",
+        ),
+        (
+            np.sqrt(e2).sum() / d,
+            "the distances are summed, not averaged (and not squared)",
+            "RMS = sqrt(mean_i |x_i - x_i^clean|^2)",
+        ),
+        (
+            rms / np.sqrt(3) / d,
+            "the mean runs over the 3n coordinates instead of the n vertices",
+            "square the length of each vertex's displacement, then average over vertices",
+        ),
+        (
+            rms / d_noisy,
+            "divided by the noisy mesh's diagonal instead of the clean one",
+            "d is the bounding-box diagonal of V_clean, the truth we measure against",
+        ),
+    ]
+
+
+@exercise("vertex_rms", reread=RMS_SECTION)
+def vertex_rms(fn):
+    """Check ``fn(V, V_clean) -> float``: sqrt(mean_i |x_i - x_i^clean|^2) / d(V_clean)."""
+    checked = []
+    for label, V, V_clean in _rms_cases():
+        out = call(fn, V.copy(), V_clean.copy())
+        if isinstance(out, np.ndarray) and out.size != 1:
+            raise Mistake(
+                f"the function returned an array of shape {out.shape}, not one number",
+                "average over all vertices, so the result is a single float",
+            )
+        try:
+            value = float(out)
+        except (TypeError, ValueError):
+            raise Mistake(
+                f"the function returned {type(out).__name__}, not a number",
+                "return one float, the RMS distance divided by the diagonal",
+            ) from None
+        d = bounding_box_diagonal(V_clean)
+        e2 = np.einsum("ij,ij->i", V - V_clean, V - V_clean)
+        expected = np.sqrt(e2.mean()) / d
+        if np.isclose(value, expected, rtol=1e-9, atol=1e-15):
+            checked.append(label)
+            continue
+        if np.isclose(value, -expected, rtol=1e-9):
+            raise Mistake("the result is negative", "a root mean square is >= 0")
+        for wrong, diagnosis, hint in _rms_mistakes(V, V_clean):
+            if np.isclose(value, wrong, rtol=1e-9, atol=1e-15):
+                raise Mistake(diagnosis, hint)
+        raise Mistake(
+            f"on {label} the result is {value:.6g}, expected {expected:.6g}",
+            "RMS = sqrt(mean_i |x_i - x_i^clean|^2) / d, d the clean mesh's bounding-box diagonal",
+        )
+    return checked

@@ -1,0 +1,250 @@
+"""Experiment driver of notebook 07: Laplacian smoothing swept over noise levels, schemes, steps, iterations.
+
+Not a lesson and not a building block: it strings together :func:`geomlib.add_noise`,
+the smoothers of :mod:`geomlib.lessons.smoothing` and the metrics of
+:mod:`geomlib.lessons.metrics`, and records every metric of every setting in a
+:class:`SmoothingSweep`. The scale-free step of each scheme is
+:func:`scale_free_step`.
+"""
+
+import time
+import warnings
+
+import numpy as np
+
+from ..lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
+from ..lessons.noise import add_noise
+from ..lessons.smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit
+from ..mesh.errors import MeshError, MeshWarning
+from ..mesh.geometry import mean_edge_length
+
+__all__ = [
+    "SCHEMES",
+    "EXPLICIT_FRACTIONS",
+    "IMPLICIT_STEPS",
+    "SWEEP_ITERATIONS",
+    "SWEEP_KEYS",
+    "HAUSDORFF_SAMPLES_PER_FACE",
+    "scale_free_step",
+    "SmoothingSweep",
+    "smoothing_sweep",
+]
+
+#: (method, weights) pairs compared by :func:`smoothing_sweep`.
+SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"), ("implicit", "uniform"), ("implicit", "cotan"))
+
+#: Explicit steps of the sweep, as fractions of the stability limit
+#: ``2 / lambda_max`` of the mesh being smoothed (below 1 is stable).
+EXPLICIT_FRACTIONS = (0.1, 0.25, 0.5, 0.9)
+
+#: Implicit steps of the sweep, scale-free (see :func:`scale_free_step`).
+IMPLICIT_STEPS = (0.1, 0.3, 1.0)
+
+#: Iteration counts at which the sweep measures every run.
+SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
+
+#: Metric keys recorded by the sweep (all of :meth:`MeshComparison.evaluate`
+#: except the Hausdorff estimate, which is measured for chosen results only).
+SWEEP_KEYS = ("rms", "normal_mean", "normal_p95", "area_change", "volume_change", "sharp_edge_error")
+
+
+def scale_free_step(V, F, method, weights, value):
+    """The smoothing step (units of :mod:`geomlib.lessons.smoothing`) for a scale-free ``value``.
+
+    * explicit: ``value`` is a fraction of the stability limit of this mesh,
+      ``step = value * explicit_step_limit(V, F, weights)``.
+    * implicit, uniform weights: ``Delta`` is dimensionless, ``step = value``.
+    * implicit, cotangent weights: ``step = value * h^2 / 4`` with ``h`` the
+      mean edge length of this mesh. On an equilateral mesh the cotangent
+      Laplacian is the uniform one divided by ``h^2 / 4``, so the same
+      ``value`` diffuses by the same amount with either weights, at any scale.
+
+    For the cotangent operator of a *noisy* mesh the explicit limit collapses
+    (noise makes obtuse triangles with large cotangents), which is why the
+    implicit step is not tied to it.
+    """
+    if method == "explicit":
+        return float(value) * explicit_step_limit(V, F, weights)
+    if method != "implicit":
+        raise MeshError(f"method must be 'explicit' or 'implicit', not {method!r}")
+    if weights == "uniform":
+        return float(value)
+    if weights == "cotan":
+        return float(value) * mean_edge_length(V, F) ** 2 / 4.0
+    raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
+
+
+class SmoothingSweep:
+    """Results of :func:`smoothing_sweep`: every metric for every setting.
+
+    Attributes
+    ----------
+    sigmas : (a,) float64
+        Noise levels (fractions of the bounding-box diagonal).
+    schemes : list of (method, weights)
+    step_values : dict method -> tuple
+        The scale-free step values (:func:`scale_free_step`).
+    steps : (a, s, b) float64
+        The actual step used for noise level i, scheme j, step value k.
+    iterations : (c,) int64
+    values : dict key -> (a, s, b, c) float64
+        ``values["rms"][i, j, k, l]``: the metric after ``iterations[l]``
+        iterations. NaN where a run stopped early (divergence).
+    noisy : dict key -> (a,) float64
+        The metrics of the noisy input itself.
+    seconds : float
+        Wall-clock time of the sweep.
+    """
+
+    def __init__(self, sigmas, schemes, step_values, iterations):
+        self.sigmas = np.asarray(sigmas, dtype=np.float64)
+        self.schemes = list(schemes)
+        self.step_values = dict(step_values)
+        self.iterations = np.asarray(iterations, dtype=np.int64)
+        b = max(len(v) for v in self.step_values.values())
+        shape = (len(self.sigmas), len(self.schemes), b, len(self.iterations))
+        self.steps = np.full(shape[:3], np.nan)
+        self.values = {key: np.full(shape, np.nan) for key in SWEEP_KEYS}
+        self.noisy = {key: np.full(len(self.sigmas), np.nan) for key in SWEEP_KEYS}
+        self.seconds = float("nan")
+
+    def best(self, i, key="rms", schemes=None):
+        """The setting with the smallest ``key`` at noise level ``i``.
+
+        Parameters
+        ----------
+        i : int
+            Index into ``sigmas``.
+        key : str
+            A metric of ``values`` (smaller is better; for signed changes the
+            absolute value counts).
+        schemes : list of (method, weights), optional
+            Restrict the search to these schemes.
+
+        Returns
+        -------
+        dict with ``method``, ``weights``, ``step_value``, ``step``,
+        ``iterations``, the metrics of that setting (every key of ``values``)
+        and ``index`` (j, k, l) into ``values``.
+        """
+        allowed = [j for j, s in enumerate(self.schemes) if schemes is None or s in schemes]
+        block = np.abs(self.values[key][i])
+        mask = np.full(block.shape, np.inf)
+        mask[allowed] = 0.0
+        block = np.where(np.isnan(block), np.inf, block) + mask
+        j, k, l = np.unravel_index(int(np.argmin(block)), block.shape)
+        method, weights = self.schemes[j]
+        out = {
+            "method": method,
+            "weights": weights,
+            "step_value": self.step_values[method][k],
+            "step": float(self.steps[i, j, k]),
+            "iterations": int(self.iterations[l]),
+            "index": (int(j), int(k), int(l)),
+        }
+        out.update({name: float(v[i, j, k, l]) for name, v in self.values.items()})
+        return out
+
+
+def smoothing_sweep(
+    V_clean,
+    F,
+    sigmas,
+    seed,
+    schemes=SCHEMES,
+    explicit_fractions=EXPLICIT_FRACTIONS,
+    implicit_steps=IMPLICIT_STEPS,
+    iterations=SWEEP_ITERATIONS,
+    direction="isotropic",
+    comparison=None,
+    progress=True,
+):
+    """Add noise at each level, smooth it with every scheme, step and iteration count, measure.
+
+    For every noise level ``sigma`` (a fraction of the bounding-box
+    diagonal) the noisy mesh is ``add_noise(V_clean, F, sigma, seed,
+    direction)`` (the same seed at every level: the same noise pattern,
+    growing). Every scheme ``(method, weights)`` then smooths it with every
+    step value (:func:`scale_free_step`) for ``max(iterations)`` iterations,
+    and the mesh is measured against the clean one after each count in
+    ``iterations`` (:meth:`MeshComparison.evaluate` without the Hausdorff
+    estimate). One run per (noise level, scheme, step) covers all iteration
+    counts. The operators are those of the noisy mesh, assembled once per
+    (noisy mesh, weights) and kept fixed, as in
+    :func:`geomlib.explicit_smoothing` and :func:`geomlib.implicit_smoothing`
+    (:class:`geomlib.lessons.smoothing.ExplicitSmoother`,
+    :class:`geomlib.lessons.smoothing.ImplicitSmoother`); implicit runs factorise
+    ``M - step C`` once per step.
+
+    Parameters
+    ----------
+    V_clean : (n, 3) float64
+    F : (m, 3) int64
+    sigmas : sequence of float
+    seed : int
+    schemes : sequence of (method, weights)
+    explicit_fractions, implicit_steps : sequence of float
+        Scale-free step values of the explicit and implicit runs.
+    iterations : sequence of int
+        Increasing iteration counts at which to measure.
+    direction : "isotropic" or "normal"
+        Of the noise (:func:`geomlib.add_noise`).
+    comparison : MeshComparison, optional
+        Reuse one built for (V_clean, F).
+    progress : bool
+        A tqdm.auto progress bar over the runs.
+
+    Returns
+    -------
+    SmoothingSweep
+    """
+    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    iterations = np.asarray(sorted(set(int(k) for k in iterations)), dtype=np.int64)
+    if len(iterations) == 0 or iterations[0] < 1:
+        raise MeshError("iterations must be positive whole numbers")
+    step_values = {"explicit": tuple(explicit_fractions), "implicit": tuple(implicit_steps)}
+    for method, weights in schemes:
+        if method not in step_values or weights not in ("uniform", "cotan"):
+            raise MeshError(
+                f"unknown scheme ({method!r}, {weights!r}); methods are 'explicit' and "
+                "'implicit', weights 'uniform' and 'cotan'"
+            )
+    out = SmoothingSweep(sigmas, schemes, step_values, iterations)
+    where = {int(k): l for l, k in enumerate(iterations)}
+    last = int(iterations[-1])
+    runs = sum(len(step_values[m]) for m, _ in schemes) * len(out.sigmas)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=runs, desc="smoothing sweep")
+    start = time.perf_counter()
+    try:
+        for i, sigma in enumerate(out.sigmas):
+            Vn = add_noise(C.V_clean, C.F, sigma, seed, direction=direction)
+            for key, value in C.evaluate(Vn, hausdorff=False).items():
+                out.noisy[key][i] = value
+            for j, (method, weights) in enumerate(schemes):
+                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
+                for k, value in enumerate(step_values[method]):
+                    step = scale_free_step(Vn, C.F, method, weights, value)
+                    out.steps[i, j, k] = step
+
+                    def record(it, P, i=i, j=j, k=k):
+                        if it in where:
+                            for name, v in C.evaluate(P, hausdorff=False).items():
+                                out.values[name][i, j, k, where[it]] = v
+
+                    with warnings.catch_warnings():
+                        warnings.simplefilter("ignore", MeshWarning)
+                        if method == "explicit":
+                            smoother.smooth(step, last, callback=record, on_failure="stop", progress=False)
+                        else:
+                            smoother.smooth(step, last, callback=record, progress=False)
+                    if bar is not None:
+                        bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    out.seconds = time.perf_counter() - start
+    return out
