@@ -89,6 +89,11 @@ state it embeds the live widget, which needs the widget scripts from a CDN.)
 A view shown inside an ipywidgets box (``VBox([slider, view.widget])``) is
 drawn too: importing this module in IPython gives every box holding views a
 still picture of them (``box_still``), side by side.
+
+While nbgrader runs a notebook (``autograde``, ``validate``) a view gives its
+still picture and summary only, without the widget (``stills_only``): the
+feedback pages are static HTML without widget state, where a widget would be an
+empty placeholder in place of the picture.
 """
 
 import base64
@@ -100,8 +105,18 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..mesh.errors import MeshError, format_indices
+from .notebook import graded
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fast", "render_still", "box_still"]
+__all__ = [
+    "MeshView",
+    "ViewRow",
+    "side_by_side",
+    "colorize",
+    "vertex_normals_fast",
+    "render_still",
+    "box_still",
+    "stills_only",
+]
 
 #: colour of vertices whose value is NaN (RGB in [0, 1])
 NAN_COLOR = (0.62, 0.62, 0.62)
@@ -941,7 +956,7 @@ class MeshView:
         return text
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         bundle["image/png"] = _png(self.still())
         bundle["text/plain"] = self.summary()
         return bundle
@@ -964,7 +979,7 @@ class ViewRow:
         return _in_a_row([v.still(distance=self._distance) for v in self.views])
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         bundle["image/png"] = _png(self.still())
         bundle["text/plain"] = "\n".join(v.summary() for v in self.views)
         return bundle
@@ -1014,8 +1029,22 @@ def _box_png(box):
     return None if image is None else _png(image)
 
 
+def stills_only():
+    """Whether views are shown as still pictures without their widgets: while nbgrader runs
+    the notebook, whose feedback pages are static HTML (a widget there is an empty placeholder)."""
+    return graded()
+
+
+def _box_stills_only(box):
+    image = box_still(box)
+    if image is None:
+        return box._repr_mimebundle_()
+    return {"image/png": _png(image), "text/plain": "still picture of the 3D views (live in Jupyter)"}
+
+
 def _give_boxes_stills():
-    """In IPython, display every ipywidgets box with the still of its views as image/png."""
+    """In IPython, display every ipywidgets box with the still of its views as image/png
+    (with ``stills_only``, the still instead of the box's widget)."""
     from IPython import get_ipython
 
     shell = get_ipython()
@@ -1023,6 +1052,8 @@ def _give_boxes_stills():
         import ipywidgets
 
         shell.display_formatter.formatters["image/png"].for_type(ipywidgets.Box, _box_png)
+        if stills_only():
+            shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.Box, _box_stills_only)
 
 
 _give_boxes_stills()
