@@ -91,9 +91,9 @@ drawn too: importing this module in IPython gives every box holding views a
 still picture of them (``box_still``), side by side.
 
 While nbgrader runs a notebook (``autograde``, ``validate``) a view gives its
-still picture and summary only, without the widget (``stills_only``): the
-feedback pages are static HTML without widget state, where a widget would be an
-empty placeholder in place of the picture.
+still picture and summary only, without the widget (``stills_only``), and other
+widgets their text: the feedback pages are static HTML without widget
+state, where a widget would be an empty placeholder.
 """
 
 import base64
@@ -1035,16 +1035,17 @@ def stills_only():
     return graded()
 
 
-def _box_stills_only(box):
-    image = box_still(box)
-    if image is None:
-        return box._repr_mimebundle_()
+def _widget_stills_only(widget):
+    image = box_still(widget)
+    if image is None:  # a slider, a progress bar, an Output widget: its text, as without a front-end
+        return {"text/plain": repr(widget)}
     return {"image/png": _png(image), "text/plain": "still picture of the 3D views (live in Jupyter)"}
 
 
 def _give_boxes_stills():
     """In IPython, display every ipywidgets box with the still of its views as image/png
-    (with ``stills_only``, the still instead of the box's widget)."""
+    (with ``stills_only``, every widget without its widget view: a box as the still of
+    its views, any other as its text)."""
     from IPython import get_ipython
 
     shell = get_ipython()
@@ -1053,7 +1054,7 @@ def _give_boxes_stills():
 
         shell.display_formatter.formatters["image/png"].for_type(ipywidgets.Box, _box_png)
         if stills_only():
-            shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.Box, _box_stills_only)
+            shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_stills_only)
 
 
 _give_boxes_stills()

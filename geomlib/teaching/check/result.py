@@ -36,10 +36,10 @@ page shows the diagnosis. Each exercise has two grade cells:
 
 * ``check.NAME(fn)``: all of the exercise's remaining points, for a function
   that passes;
-* ``check.NAME.partial_credit(fn)``: one point, for a function that runs on
-  every case and is either right or wrong by a mistake the check names
-  (``Mistake(..., typical=True)``, the default). A catch-all diagnosis ("C
-  differs from ..."), a wrong shape, an exception or a stub earn nothing.
+* ``check.NAME.partial_credit(fn)``: one point, for a function that is right
+  or whose first mistake is one the check names (``Mistake(..., typical=True)``,
+  the default). A catch-all diagnosis ("C differs from ..."), a wrong shape or
+  type, an exception or a stub earn nothing.
 
 ``use`` calls ``check.NAME.evaluate(fn)``, which never raises, so the cells after
 an exercise run on geomlib's own function in every mode. Warnings raised by the
@@ -226,12 +226,12 @@ def exercise(name, reread):
             return _enforce(evaluate(fn))
 
         def partial_credit(fn):
-            """Partial credit: ``fn`` runs and is right or wrong by a typical mistake the check names."""
+            """Partial credit: ``fn`` is right, or the first thing wrong is a typical mistake the check names."""
             result = evaluate(fn)
             if result.passed:
                 message = "earned: the function passes its check."
             elif result.partial:
-                message = "earned: the function runs on every case, and the check above names its mistake."
+                message = "earned: what is wrong is a typical mistake, named by the check above."
             elif not result.written:
                 message = result.message
             else:
