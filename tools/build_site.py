@@ -442,6 +442,19 @@ def build(out=OUT, names=None, log=print):
     return pages
 
 
+def write_page(nb, out, name):
+    """Write the executed notebook ``nb`` as ``out/<name>.html``, a page as the site's (its
+    3D views live, the pinned JavaScript in ``out/assets/``) without the site's links;
+    returns the page's path. Used for one run of a notebook (tools/run_notebook.py)."""
+    out = Path(out)
+    install_assets(out)
+    prepare_for_site(nb)
+    body, _ = exporter().from_notebook_node(nb, resources={"site_nav": "", "metadata": {"name": title_of(nb, name)}})
+    page = out / f"{name}.html"
+    page.write_text(body, encoding="utf-8")
+    return page
+
+
 def folder_size(path):
     return sum(f.stat().st_size for f in Path(path).rglob("*") if f.is_file())
 
