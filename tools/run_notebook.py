@@ -240,7 +240,7 @@ class Parameter:
 NOT_A_LITERAL = object()
 
 
-def _literal(text):
+def read_literal(text):
     try:
         return ast.literal_eval(text.strip())
     except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
@@ -262,7 +262,7 @@ def notebook_parameters(path):
         if not m:
             raise ValueError(f"{Path(path).name}: the comment of {name} does not end with its range in parentheses")
         try:
-            spec = parse_spec(m[1], _literal(default))
+            spec = parse_spec(m[1], read_literal(default))
         except (ValueError, SyntaxError) as e:
             raise ValueError(f"{Path(path).name}: the range of {name}, ({m[1]}), cannot be read: {e}") from None
         result.append(Parameter(name, default, comment, spec))
@@ -292,7 +292,7 @@ def listing(notebook, parameters):
 
 def parse_value(text, spec):
     """The value ``text`` stands for: a Python literal, or else the text itself (a path, a unit)."""
-    value = _literal(text)
+    value = read_literal(text)
     if value is NOT_A_LITERAL or (isinstance(spec, FilePath) and not (value is None or isinstance(value, str))):
         return text  # a bare word, or a file name that happens to read as a number
     return value
@@ -334,6 +334,16 @@ def run_folder(notebook):
     return folder
 
 
+def for_papermill(value):
+    """``value`` with every tuple made a list: papermill writes a list as a list literal,
+    but a tuple as the string of its text."""
+    if isinstance(value, (tuple, list)):
+        return [for_papermill(v) for v in value]
+    if isinstance(value, dict):
+        return {k: for_papermill(v) for k, v in value.items()}
+    return value
+
+
 def run(notebook, values, timeout=3600):
     """Execute ``notebook`` with ``values`` in a fresh kernel; write the notebook and its page.
 
@@ -351,7 +361,7 @@ def run(notebook, values, timeout=3600):
         nb = papermill.execute_notebook(
             notebook,
             executed,
-            parameters=values,
+            parameters=for_papermill(values),
             kernel_name="python3",
             cwd=folder,  # whatever the notebook writes stays with the run
             progress_bar=False,
