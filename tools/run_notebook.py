@@ -366,6 +366,8 @@ def run(notebook, values, timeout=3600):
             cwd=folder,  # whatever the notebook writes stays with the run
             progress_bar=False,
             execution_timeout=timeout,
+            # the kernel's start-up log (a warning about its local TCP sockets) is not the reader's business
+            extra_arguments=["--IPKernelApp.log_level=ERROR"],
         )
     except PapermillExecutionError as e:
         message = e.evalue.strip()
