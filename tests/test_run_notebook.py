@@ -210,6 +210,31 @@ def test_a_notebook_by_number_name_or_file_name():
         rn.find_notebook("5")
 
 
+@pytest.mark.parametrize(
+    "error, sentence",
+    [
+        (("MeshError", "/m/x.obj: no such file"), "stopped in cell [4]: /m/x.obj: no such file (see "),
+        (("ValueError", "bad value"), "stopped in cell [4]: ValueError: bad value (see "),
+        ("timeout", "did not finish: A cell timed out while it was being executed, after 9 seconds. (see "),
+    ],
+)
+def test_a_notebook_that_stops_is_one_sentence(error, sentence, tmp_path, monkeypatch):
+    import papermill
+    from nbclient.exceptions import CellTimeoutError
+    from papermill.exceptions import PapermillExecutionError
+
+    def execute_notebook(*args, **kwargs):
+        if error == "timeout":
+            raise CellTimeoutError.error_from_timeout_and_cell("A cell timed out", 9, nbformat.v4.new_code_cell("x"))
+        raise PapermillExecutionError(4, 4, "load_mesh(MESH)", *error, ["Traceback ...", "more"])
+
+    monkeypatch.setattr(papermill, "execute_notebook", execute_notebook)
+    monkeypatch.setattr(rn, "RUNS", tmp_path)
+    with pytest.raises(UsageError) as e:
+        rn.run(rn.find_notebook("00"), {})
+    assert str(e.value).startswith("00_getting_started " + sentence) and "\n" not in str(e.value)
+
+
 # ---------------------------------------------------------------------------
 # end to end
 # ---------------------------------------------------------------------------

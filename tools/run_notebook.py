@@ -37,6 +37,7 @@ its message (exit status 1).
 """
 
 import ast
+import logging
 import math
 import re
 import sys
@@ -350,11 +351,14 @@ def run(notebook, values, timeout=3600):
     Returns the page's path. Raises UsageError with one sentence when a cell raises.
     """
     import papermill
+    from nbclient.exceptions import CellTimeoutError, DeadKernelError
     from papermill.exceptions import PapermillExecutionError
 
     sys.path.insert(0, str(ROOT / "tools"))
     import build_site
 
+    # what papermill logs about a failure (a timeout, a dead kernel) is in the one sentence below
+    logging.getLogger("papermill").addHandler(logging.NullHandler())
     folder = run_folder(notebook)
     executed = folder / notebook.name
     try:
@@ -374,6 +378,8 @@ def run(notebook, values, timeout=3600):
         if e.ename != "MeshError":
             message = f"{e.ename}: {message}"
         raise UsageError(f"{notebook.stem} stopped in cell [{e.exec_count}]: {message} (see {executed})") from None
+    except (CellTimeoutError, DeadKernelError) as e:
+        raise UsageError(f"{notebook.stem} did not finish: {str(e).strip().splitlines()[0]} (see {executed})") from None
     return build_site.write_page(nb, folder, notebook.stem)
 
 
