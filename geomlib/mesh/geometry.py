@@ -85,9 +85,11 @@ def vertex_normals(V, F):
     face of non-zero area has no normal: its row is (0, 0, 0), not NaN.
     """
     V, F = as_mesh(V, F)
-    N2 = face_cross(V, F)
-    N = np.stack([np.bincount(F.ravel(), np.repeat(N2[:, k], 3), minlength=len(V)) for k in range(3)], axis=1)
-    length = np.linalg.norm(N, axis=1, keepdims=True)
+    v0, v1, v2 = corner_positions(V, F)
+    N2 = cross(v1 - v0, v2 - v0)  # (3, m) coordinate rows of 2 A_f n_f
+    corners = F.T.ravel()  # corner by corner, matching np.tile of each row
+    N = np.stack([np.bincount(corners, np.tile(N2[k], 3), minlength=len(V)) for k in range(3)], axis=1)
+    length = np.sqrt(np.einsum("ij,ij->i", N, N))[:, None]
     return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
 
 
