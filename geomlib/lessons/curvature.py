@@ -37,7 +37,7 @@ import warnings
 import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
-from ..mesh.geometry import face_normals, vertex_normals
+from ..mesh.geometry import vertex_normals
 from ..mesh.topology import boundary_edge_counts, edge_face_counts
 from ..mesh.validate import as_mesh, check_choice
 from .laplace import check_options, face_geometry, laplacian, vertex_areas
@@ -49,8 +49,6 @@ __all__ = [
     "angle_deficit",
     "angle_sums",
     "corner_angles",
-    "vertex_normals",
-    "face_normals",
     "boundary_mask",
     "BOUNDARY_RULES",
     "MEAN_BOUNDARY_RULES",
