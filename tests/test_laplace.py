@@ -369,3 +369,18 @@ def test_teaching_functions_against_libigl_one_by_one():
     np.testing.assert_allclose(
         mixed_areas(V, F), igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal(), rtol=1e-12
     )
+
+
+def test_laplacian_measures_the_faces_once(monkeypatch):
+    import geomlib.lessons.laplace as laplace
+
+    calls = []
+    measure = laplace.face_geometry
+    monkeypatch.setattr(laplace, "face_geometry", lambda V, F: calls.append(1) or measure(V, F))
+    V, F = surfaces.sphere(1.0, subdivisions=2).V, surfaces.sphere(1.0, subdivisions=2).F
+    for area in ("barycentric", "mixed"):
+        calls.clear()
+        M, C = laplacian(V, F, area=area)
+        assert len(calls) == 1
+        np.testing.assert_array_equal(C.toarray(), cotangent_matrix(V, F).toarray())
+        np.testing.assert_array_equal(M.diagonal(), vertex_areas(V, F, area))

@@ -654,3 +654,22 @@ def test_prepare_shows_progress_when_long(monkeypatch, capsys):
     monkeypatch.setattr(progress, "SECONDS", 0.0)
     ImplicitSmoother(V, F).prepare([0.01, 0.1, 1.0], iterations=2)
     assert "factorising the step values" in capsys.readouterr().err
+
+
+def test_design_contract_calls_keep_working():
+    V, F = icosphere(2)
+    tau = 0.3 * explicit_step_limit(V, F)
+    P = explicit_smoothing(V, F, tau, 3, weights="uniform")  # explicit_smoothing(V, F, step, iterations, weights=...)
+    np.testing.assert_array_equal(explicit_smoothing(V, F, step=tau, iterations=3, weights="uniform"), P)
+    Q = implicit_smoothing(V, F, tau, 3, "cotan")
+    np.testing.assert_array_equal(implicit_smoothing(V, F, step=tau, iterations=3, weights="cotan"), Q)
+    with pytest.raises(MeshError, match="once"):
+        explicit_smoothing(V, F, tau, 3, step=tau)
+
+
+def test_an_unknown_option_names_the_option_the_value_and_the_choices():
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match=r"boundary_condition must be one of 'fixed', 'free', not 'clamped'"):
+        implicit_smoothing(V, F, 0.1, 1, boundary_condition="clamped")
+    with pytest.raises(MeshError, match=r"solver must be one of 'cholesky', 'cg', not 'lu'"):
+        implicit_smoothing(V, F, 0.1, 1, solver="lu")
