@@ -50,6 +50,7 @@ import numpy as np
 
 from ..mesh.errors import MeshError, format_indices
 from ..mesh.geometry import face_cross
+from ..mesh.validate import check_choice
 
 __all__ = [
     "AnalyticMesh",
@@ -262,12 +263,8 @@ def grid_faces(nu, nv, periodic_u=False, periodic_v=False, diagonals="right"):
     b = I1 * nv + J
     c = I1 * nv + J1
     d = I * nv + J1
-    if diagonals == "right":
-        flip = np.zeros(a.shape, dtype=bool)
-    elif diagonals == "alternate":
-        flip = (I + J) % 2 == 1
-    else:
-        raise MeshError(f"diagonals must be 'right' or 'alternate', got {diagonals!r}")
+    check_choice("diagonals", diagonals, ("right", "alternate"))
+    flip = (I + J) % 2 == 1 if diagonals == "alternate" else np.zeros(a.shape, dtype=bool)
     t1 = np.where(flip[:, None], np.stack([a, b, d], 1), np.stack([a, b, c], 1))
     t2 = np.where(flip[:, None], np.stack([b, c, d], 1), np.stack([a, c, d], 1))
     F = np.empty((2 * a.size, 3), dtype=np.int64)
