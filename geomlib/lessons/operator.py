@@ -105,6 +105,8 @@ class LaplaceOperator:
     @cached_property
     def blocks(self):
         """``(C_II, C_IB)``: C's rows of the moving vertices, split into moving and fixed columns."""
+        if not len(self.B):
+            return self.C, sp.csr_matrix((len(self.I), 0))  # nothing fixed: no copy of C
         C_I = self.C[self.I]
         return C_I[:, self.I].tocsr(), C_I[:, self.B].tocsr()
 
