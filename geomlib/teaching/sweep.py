@@ -16,7 +16,7 @@ from ..lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
 from ..lessons.noise import add_noise
 from ..lessons.smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit
 from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.geometry import mean_edge_length
+from .steps import absolute_step
 
 __all__ = [
     "SCHEMES",
@@ -67,11 +67,9 @@ def scale_free_step(V, F, method, weights, value):
         return float(value) * explicit_step_limit(V, F, weights)
     if method != "implicit":
         raise MeshError(f"method must be 'explicit' or 'implicit', not {method!r}")
-    if weights == "uniform":
-        return float(value)
-    if weights == "cotan":
-        return float(value) * mean_edge_length(V, F) ** 2 / 4.0
-    raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
+    if weights not in ("uniform", "cotan"):
+        raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
+    return absolute_step(value / 4.0 if weights == "cotan" else value, "ell^2", V, F, weights)
 
 
 class SmoothingSweep:
