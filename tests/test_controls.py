@@ -49,7 +49,7 @@ def test_one_step_for_every_mesh(meshes):
     for name, (V, F) in meshes.items():
         assert steps.tau(name) == pytest.approx(0.03 * mean_edge_length(V, F) ** 2, rel=1e-14)
         assert steps.at(name, 0.3) == pytest.approx(10 * steps.tau(name), rel=1e-14)  # the slider shows STEP
-    assert str(steps) == "STEP = 0.03 ell^2"
+    assert str(steps) == "STEP = 0.03 ell^2" and f"{steps:.3f}" == "0.030"
 
 
 def test_one_step_per_mesh(meshes):
@@ -57,6 +57,7 @@ def test_one_step_per_mesh(meshes):
     assert steps.tau("plane") == 1e-6 and steps.tau("part") == 1e-4
     assert steps.at("plane", 10.0) == pytest.approx(1e-5) and steps.at("part", 10.0) == pytest.approx(1e-3)
     assert str(steps) == "STEP = {PLANE: 1e-06, PART: 0.0001} length^2"
+    assert f"{steps:.1e}" == "{PLANE: 1.0e-06, PART: 1.0e-04}"  # as a notebook's text formats STEP
     only_part = MeshSteps({"PART": 1e-4, "PLANE": 1e-3}, "length^2", {**meshes, "cube": meshes["plane"]})
     assert only_part.tau("cube") == 1e-4  # a mesh left out gets the smallest step given
 

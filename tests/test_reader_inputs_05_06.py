@@ -116,6 +116,24 @@ def test_06_course_meshes_with_the_assignments_absolute_step():
     assert len(run.notes) == 1 and "near the limit an explicit step damps the top mode only by" in run.notes[0]
 
 
+@needs_course
+def test_06_one_step_per_mesh():
+    run = run_notebook(
+        "06_implicit_smoothing.ipynb",
+        PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+        PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
+        STEP={"PLANE": 1e-6, "PART": 1e-4},
+        STEP_UNIT="length^2",
+        ITERATIONS=1,
+        SMOOTHING_TIME=0.1,
+    )
+    run.assert_ran()
+    text = run.outputs_text()
+    assert "| 1e-06 | 0.03545 | 0.2118 |" in text and "| 0.0001 | 0.00833 | 0.2782 |" in text
+    assert "steps of STEP = {CUBE: 1e-06, PLANE: 1e-06, PART: 0.0001, SPHERE: 1e-06} (length^2)" in text
+    assert "tau = 0.0001 (0.278 x the explicit limit)" in text  # the live view smooths PART with its own step
+
+
 def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
     run = run_notebook(
         "06_implicit_smoothing.ipynb",

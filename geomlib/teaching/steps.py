@@ -108,8 +108,11 @@ class MeshSteps:
         """The step of mesh ``name`` as the parameter cell gives it: "STEP = 0.03 ell^2"."""
         return f"STEP = {self.values[name]:g} {self.unit}"
 
-    def __str__(self):
+    def __format__(self, spec):
+        """STEP's value(s) formatted with ``spec``: "0.03", or "{PLANE: 1e-06, PART: 0.0001}"."""
         if not self.per_mesh:
-            return f"STEP = {self.values[next(iter(self.values))]:g} {self.unit}"
-        given = ", ".join(f"{name.upper()}: {value:g}" for name, value in self.values.items())
-        return f"STEP = {{{given}}} {self.unit}"
+            return format(self.values[next(iter(self.values))], spec or "g")
+        return "{" + ", ".join(f"{name.upper()}: {value:{spec or 'g'}}" for name, value in self.values.items()) + "}"
+
+    def __str__(self):
+        return f"STEP = {self:g} {self.unit}"
