@@ -11,9 +11,9 @@ import pytest
 from geomlib import MeshError, MeshWarning
 from geomlib.mesh.geometry import enclosed_volume, mean_edge_length
 from geomlib.teaching import surfaces
-from geomlib.teaching.controls import live, log_positions, log_slider, mesh_warnings
+from geomlib.teaching.controls import live, mesh_warnings
 from geomlib.teaching.glyphs import Glyphs, arrow_meshes, marker_meshes
-from geomlib.teaching.steps import MeshSteps, absolute_step
+from geomlib.teaching.steps import MeshSteps, absolute_step, log_positions, log_slider
 from geomlib.teaching.sweep import scale_free_step
 from geomlib.teaching.viewer import MeshView
 

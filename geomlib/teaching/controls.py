@@ -7,7 +7,7 @@ update and shows a read-out line under the controls: the text ``update``
 returns, the warnings the run raised (a diverging run's ``MeshWarning``), and
 the time it took.
 
-    steps = log_slider(STEP, lo, hi, "τ / ℓ²")
+    steps = log_slider(STEP, lo, hi, "τ / ℓ²")      # geomlib.teaching.steps
     n = ipywidgets.IntSlider(30, min=0, max=300, description="iterations", continuous_update=False)
 
     def update(step, iterations):
@@ -27,13 +27,11 @@ import html
 import time
 import warnings
 
-import numpy as np
-
 from ..mesh.errors import MeshError, MeshWarning
 from .stills import png_base64
 from .viewer import MeshView, ViewRow, box_still
 
-__all__ = ["live", "Live", "log_slider", "log_positions", "mesh_warnings"]
+__all__ = ["live", "Live", "mesh_warnings"]
 
 
 def mesh_warnings(run, *args, **kwargs):
@@ -42,37 +40,6 @@ def mesh_warnings(run, *args, **kwargs):
         warnings.simplefilter("always", MeshWarning)
         result = run(*args, **kwargs)
     return result, [str(w.message) for w in caught if issubclass(w.category, MeshWarning)]
-
-
-def log_slider(value, lo, hi, description, grid=0.05):
-    """A logarithmic slider at ``value`` whose positions ``value * 10^(grid k)`` reach from ``lo`` to ``hi``.
-
-    ``value`` itself is a position, so the number a reader typed is on the
-    slider. It updates when released (``continuous_update=False``): one run per move.
-    """
-    import ipywidgets
-
-    if not (value > 0 and lo > 0 and hi > 0):
-        raise MeshError(f"a logarithmic slider needs positive numbers; got value {value}, range {lo}..{hi}")
-    centre = np.log10(value)
-    low = centre - grid * np.ceil((centre - np.log10(min(lo, value))) / grid)
-    high = centre + grid * np.ceil((np.log10(max(hi, value)) - centre) / grid)
-    return ipywidgets.FloatLogSlider(
-        value=value,
-        base=10,
-        min=low,
-        max=high,
-        step=grid,
-        readout_format=".3g",
-        description=description,
-        continuous_update=False,
-    )
-
-
-def log_positions(slider):
-    """Every position of a logarithmic slider, lowest first: ``base ** (min + step k)``."""
-    count = int(round((slider.max - slider.min) / slider.step)) + 1
-    return slider.base ** (slider.min + slider.step * np.arange(count))
 
 
 class Live:

@@ -10,16 +10,16 @@ With uniform weights the Laplacian has no units and tau is a plain number in
 either unit. :func:`absolute_step` is the one conversion; :class:`MeshSteps`
 holds a notebook's ``STEP``, which is one number for every mesh or a dict by
 mesh name (``{"PLANE": 1e-6, "PART": 1e-4}``, the names of the parameters that
-hold the meshes), and gives each mesh its tau.
+hold the meshes), and gives each mesh its tau. :func:`log_slider` is a step
+slider on which the value a reader typed is a position.
 """
 
 import numpy as np
 
 from ..mesh.errors import MeshError
 from ..mesh.geometry import mean_edge_length
-from .controls import log_slider
 
-__all__ = ["STEP_UNITS", "absolute_step", "step_label", "MeshSteps"]
+__all__ = ["STEP_UNITS", "absolute_step", "step_label", "log_slider", "log_positions", "MeshSteps"]
 
 #: the units a notebook's STEP_UNIT may name
 STEP_UNITS = ("ell^2", "length^2")
@@ -42,6 +42,37 @@ def absolute_step(step, unit, V, F, weights="cotan"):
 def step_label(unit):
     """A slider's label for a step in ``unit``: "τ / ℓ²" or "τ (length²)"."""
     return "τ / ℓ²" if unit == "ell^2" else "τ (length²)"
+
+
+def log_slider(value, lo, hi, description, grid=0.05):
+    """A logarithmic slider at ``value`` whose positions ``value * 10^(grid k)`` reach from ``lo`` to ``hi``.
+
+    ``value`` itself is a position, so the number a reader typed is on the
+    slider. It updates when released (``continuous_update=False``): one run per move.
+    """
+    import ipywidgets
+
+    if not (value > 0 and lo > 0 and hi > 0):
+        raise MeshError(f"a logarithmic slider needs positive numbers; got value {value}, range {lo}..{hi}")
+    centre = np.log10(value)
+    low = centre - grid * np.ceil((centre - np.log10(min(lo, value))) / grid)
+    high = centre + grid * np.ceil((np.log10(max(hi, value)) - centre) / grid)
+    return ipywidgets.FloatLogSlider(
+        value=value,
+        base=10,
+        min=low,
+        max=high,
+        step=grid,
+        readout_format=".3g",
+        description=description,
+        continuous_update=False,
+    )
+
+
+def log_positions(slider):
+    """Every position of a logarithmic slider, lowest first: ``base ** (min + step k)``."""
+    count = int(round((slider.max - slider.min) / slider.step)) + 1
+    return slider.base ** (slider.min + slider.step * np.arange(count))
 
 
 class MeshSteps:

@@ -34,7 +34,8 @@ if there is none, the first slider displayed by the same cell as a view
 cell change. So a notebook needs at least one slider next to a view in one of
 these two ways, and that slider must change the picture whether it is moved to
 its maximum (or to its minimum when it starts there). Sliders elsewhere are
-not moved by the test. Views shown with ``side_by_side`` are also checked for
+not moved by the test (``geomlib.teaching.controls.live`` puts its controls and views in one
+box). Views shown with ``side_by_side`` are also checked for
 linked cameras (an orbit drag in the first view must turn the second).
 
 Many views on one page
