@@ -276,4 +276,4 @@ def test_workbook_run_with_a_wrong_name_exits_2_with_one_sentence():
     assert out.returncode == 2
     assert out.stdout == ""
     assert out.stderr.startswith("05_explicit_smoothing has no parameter STPE; 05_explicit_smoothing's parameters ")
-    assert out.stderr.count("\n") == 1 and "STEP (above 0)" in out.stderr
+    assert out.stderr.count("\n") == 1 and "STEP (above 0, or a dict of such values)" in out.stderr

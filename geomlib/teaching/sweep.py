@@ -17,8 +17,8 @@ from ..lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
 from ..lessons.noise import add_noise
 from ..lessons.smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit
 from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.geometry import mean_edge_length
 from ..mesh.validate import check_choice
+from .steps import absolute_step
 
 __all__ = [
     "SCHEMES",
@@ -72,9 +72,7 @@ def scale_free_step(V, F, method, weights, value):
     check_choice("weights", weights, WEIGHTS)
     if method == "explicit":
         return float(value) * explicit_step_limit(V, F, weights)
-    if weights == "uniform":
-        return float(value)
-    return float(value) * mean_edge_length(V, F) ** 2 / 4.0
+    return absolute_step(value / 4.0 if weights == "cotan" else value, "ell^2", V, F, weights)
 
 
 class SmoothingSweep:
