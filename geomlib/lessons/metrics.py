@@ -379,8 +379,9 @@ class MeshComparison:
         return V
 
     def vertex_rms(self, V, relative=True):
-        """:func:`vertex_rms` against the clean mesh."""
-        return vertex_rms(self._check(V), self.V_clean, relative)
+        """:func:`vertex_rms` against the clean mesh (relative: over the diagonal computed once)."""
+        rms = vertex_rms(self._check(V), self.V_clean, relative=False)
+        return rms / self.diagonal if relative else rms
 
     def face_normal_angles(self, V):
         """:func:`face_normal_angles` against the clean mesh, (m,) degrees."""
