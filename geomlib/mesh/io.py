@@ -68,7 +68,7 @@ import numpy as np
 
 from .errors import MeshError, MeshWarning, count_text, format_indices
 from .report import check_mesh
-from .validate import as_mesh, as_vertices
+from .validate import as_mesh, as_vertices, repeated_vertex_faces
 
 __all__ = ["load_mesh", "save_mesh", "parse_obj", "SUPPORTED_EXTENSIONS"]
 
@@ -363,9 +363,8 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
         j = np.arange(int(ntri.sum())) - first_tri[tri_poly] + 1
         o = (np.cumsum(sizes) - sizes)[tri_poly]
         F = np.stack([res[o], res[o + j], res[o + j + 1]], axis=1)
-    rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-    if rep.any():
-        rows = np.flatnonzero(rep)
+    rows = repeated_vertex_faces(F)
+    if len(rows):
         plines = lines[rows if tri_poly is None else tri_poly[rows]]
         detail = "; ".join(f"line {L}: face {r} = {F[r].tolist()}" for r, L in zip(rows[:5], plines[:5]))
         tail = f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}" if len(rows) > 1 else ""
