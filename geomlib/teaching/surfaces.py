@@ -49,7 +49,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import face_cross
+from ..mesh.geometry import face_cross, zero_area_faces
 from ..mesh.validate import check_choice
 
 __all__ = [
@@ -233,13 +233,10 @@ def _check_faces(V, F, D, what):
     three vertices; this happens only when the jitter folds the tessellation
     over, and is reported rather than repaired.
     """
-    FN = face_cross(V, F)
-    A2 = np.linalg.norm(FN, axis=1)
-    scale = np.mean(np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1)) ** 2
-    bad = np.flatnonzero(A2 <= 1e-12 * scale)
+    bad = zero_area_faces(V, F)
     if bad.size:
         raise MeshError(f"{what}: zero-area faces {format_indices(bad)}")
-    s = np.einsum("ij,ij->i", FN, D[F].sum(axis=1))
+    s = np.einsum("ij,ij->i", face_cross(V, F), D[F].sum(axis=1))
     bad = np.flatnonzero(s <= 0)
     if bad.size:
         raise MeshError(f"{what}: inverted faces {format_indices(bad)} (jitter too large for this resolution)")
