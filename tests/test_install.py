@@ -49,7 +49,9 @@ TOOLS = ["pytest>=8,<10", "nbval>=0.11,<0.12"]
 NOTEBOOK = ROOT / "notebooks" / "00_getting_started.ipynb"
 # what runs a notebook without a front-end (versions from constraints.txt)
 RUNNER = ["ipykernel", "nbclient"]
-PIP_INSTALL = ["-m", "pip", "install", "--quiet", "--no-compile"]
+# the environments get no pip of their own: the running pip installs into them (--python),
+# which saves creating one per environment and reads the same cache
+PIP = [sys.executable, "-m", "pip", "--python"]
 REPORT = ROOT / "build" / "install-test.txt"
 
 pytestmark = [pytest.mark.slow, pytest.mark.install]
@@ -113,8 +115,12 @@ def _pins():
     return pins
 
 
+def _install(python, *args):
+    return [*PIP, python, "install", "--quiet", "--no-compile", *args]
+
+
 def _freeze(python, *options):
-    out = subprocess.run([python, "-m", "pip", "freeze", *options], capture_output=True, text=True, check=True)
+    out = subprocess.run([*PIP, python, "freeze", *options], capture_output=True, text=True, check=True)
     versions = {}
     for line in out.stdout.splitlines():
         if line.startswith("#"):
@@ -127,7 +133,7 @@ def _freeze(python, *options):
 def _environment(tmp_path):
     """A fresh virtual environment: (its python, the environment variables to run it with)."""
     home = tmp_path / "venv"
-    venv.EnvBuilder(with_pip=True).create(home)
+    venv.EnvBuilder(with_pip=False).create(home)
     bindir = home / ("Scripts" if os.name == "nt" else "bin")
     python = bindir / ("python.exe" if os.name == "nt" else "python")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "JUPYTER_PATH", "VIRTUAL_ENV")}
@@ -184,7 +190,7 @@ def test_wheel_with_the_pinned_set_runs_notebook_00_from_any_folder(wheel, tmp_p
     seconds = {}
     python, env = _timed(seconds, "fresh environment", _environment, tmp_path)
     work = _elsewhere(tmp_path)
-    install = [python, *PIP_INSTALL, "-c", ROOT / "constraints.txt", wheel, *RUNNER]
+    install = _install(python, "-c", ROOT / "constraints.txt", wheel, *RUNNER)
     _timed(seconds, "pip install the wheel with the pinned set", _run, install, env, work)
 
     installed = _freeze(python)
@@ -223,13 +229,13 @@ def test_installing_geomlib_keeps_an_existing_jupyterlab_4(tmp_path):
     seconds = {}
     python, env = _timed(seconds, "fresh environment", _environment, tmp_path)
     work = _elsewhere(tmp_path)
-    existing = [python, *PIP_INSTALL, *(f"{n}=={v}" for n, v in EXISTING.items()), *TOOLS]
+    existing = _install(python, *(f"{n}=={v}" for n, v in EXISTING.items()), *TOOLS)
     _timed(seconds, "existing front-end", _run, existing, env, work)
     before = _freeze(python, "--all")
     assert {name: before.get(name) for name in EXISTING} == EXISTING
 
     # the README's command: a plain (not editable) install from the checkout
-    _timed(seconds, "pip install <checkout>", _run, [python, *PIP_INSTALL, ROOT], env, work)
+    _timed(seconds, "pip install <checkout>", _run, _install(python, ROOT), env, work)
     after = _freeze(python, "--all")
 
     changed = {name: (before.get(name), after.get(name)) for name in EXISTING if after.get(name) != before.get(name)}
