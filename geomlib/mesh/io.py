@@ -55,6 +55,8 @@ repeating a vertex (the faces and lines). Properties that do not stop a
 computation (zero-area faces, non-manifold parts, several components,
 unreferenced vertices, ...) are summarised in one :class:`~geomlib.MeshWarning`
 (see :func:`geomlib.mesh.report.check_mesh`); the mesh is returned unaltered.
+Nothing else reaches the screen: what trimesh logs while it reads a PLY or
+STL file for geomlib (tracebacks of what it recovers from) is dropped.
 """
 
 from __future__ import annotations
