@@ -20,8 +20,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "geomlib"
-# what a fresh clone does not have
-_LEFT_BY_BUILDS = shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "__pycache__", ".*_cache")
+# what a fresh clone does not have (.gitignore's entries, and git's own folder)
+_LEFT_BY_BUILDS = shutil.ignore_patterns(
+    ".git", ".venv", "build", "*.egg-info", "__pycache__", "*.pyc", ".pytest_cache", ".ipynb_checkpoints", ".cache"
+)
 _BACKEND = "import sys; from setuptools import build_meta; print(build_meta.build_{}(sys.argv[1]))"
 
 
