@@ -57,7 +57,6 @@ _EXPORTS = {
     "vertex_face_adjacency": "mesh.topology",
     # Laplacians and curvature
     "laplacian": "lessons.laplace",
-    "cotangent_weights": "lessons.laplace",
     "vertex_areas": "lessons.laplace",
     "mean_curvature": "lessons.curvature",
     "gaussian_curvature": "lessons.curvature",

@@ -235,7 +235,7 @@ def test_noisy_cad_part_moves_along_normals():
     V1, F1, _ = load("cad_part_noisy.obj")
     np.testing.assert_array_equal(F0, F1)
     D = V1 - V0
-    N = mm.vertex_normals(V0, F0)
+    N = geomlib.vertex_normals(V0, F0)
     tangential = D - np.einsum("ij,ij->i", D, N)[:, None] * N
     assert np.abs(tangential).max() < 1e-7
     sigma = 0.005 * np.linalg.norm(V0.max(0) - V0.min(0))

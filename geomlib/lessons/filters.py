@@ -20,6 +20,9 @@ more (until it overshoots past x = 1 and diverges past x = 2).
 
 import numpy as np
 
+from ..mesh.errors import MeshError
+from ..mesh.validate import check_choice
+
 __all__ = ["SCHEMES", "mode_factor", "plot_mode_factors"]
 
 SCHEMES = ("diffusion", "explicit", "implicit", "crank-nicolson", "taubin")
@@ -38,7 +41,13 @@ def mode_factor(lam, tau, scheme, tau_inflate=None):
     Returns
     -------
     ndarray of the shape of ``lam``.
+
+    Raises
+    ------
+    MeshError
+        An unknown ``scheme``; Taubin's pass without ``tau > 0 > tau_inflate``.
     """
+    check_choice("scheme", scheme, SCHEMES)
     x = tau * np.asarray(lam, dtype=float)
     if scheme == "diffusion":
         return np.exp(-x)
@@ -48,11 +57,12 @@ def mode_factor(lam, tau, scheme, tau_inflate=None):
         return 1.0 / (1.0 + x)
     if scheme == "crank-nicolson":
         return (1.0 - x / 2) / (1.0 + x / 2)
-    if scheme == "taubin":
-        if tau_inflate is None or not tau_inflate < 0 < tau:
-            raise ValueError("Taubin's pass needs tau > 0 (shrink) and tau_inflate < 0 (inflate)")
-        return (1.0 - x) * (1.0 - tau_inflate * np.asarray(lam, dtype=float))
-    raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+    if tau_inflate is None or not tau_inflate < 0 < tau:
+        raise MeshError(
+            f"Taubin's pass needs tau > 0 (shrink) and tau_inflate < 0 (inflate), not tau={tau!r}, "
+            f"tau_inflate={tau_inflate!r}"
+        )
+    return (1.0 - x) * (1.0 - tau_inflate * np.asarray(lam, dtype=float))
 
 
 def plot_mode_factors(lam_min, lam_max, tau, taubin=None, ax=None, title=None):
