@@ -107,7 +107,6 @@ import weakref
 import numpy as np
 
 from ..mesh.errors import MeshError, format_indices
-from .notebook import graded
 from .colours import (
     NAN_COLOR,
     PLAIN_COLOR,
@@ -120,6 +119,7 @@ from .colours import (
     value_range,
     zero_html,
 )
+from .notebook import graded
 from .stills import (
     FOV,
     UP,
