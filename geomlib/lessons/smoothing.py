@@ -512,7 +512,7 @@ class _Collapse(Exception):
 
 class _VolumeKeeper:
     """Rescale about the centroid so that the enclosed volume and its centroid stay
-    those of the start (Desbrun et al. 1999, section 5.3)."""
+    those of the start (the volume rescaling of Desbrun et al. 1999)."""
 
     def __init__(self, P, F):
         b = boundary_vertices(F, len(P))
@@ -596,8 +596,8 @@ def implicit_smoothing(
         of returning a NaN mesh.
     keep_volume : bool
         After every iteration rescale about the centroid of the enclosed solid
-        so that volume and centroid stay those of V (Desbrun et al. 1999,
-        section 5.3). Closed meshes only.
+        so that volume and centroid stay those of V (the volume rescaling of
+        Desbrun et al. 1999). Closed meshes only.
     solver : "cholesky" or "cg"
         For the fixed operator: a sparse Cholesky factorisation, exact to
         rounding; or conjugate gradients with a Jacobi preconditioner,

@@ -24,6 +24,8 @@ __all__ = [
     "volume_and_centroid",
     "bounding_box_diagonal",
     "mean_edge_length",
+    "ROUNDING_RTOL",
+    "zero_below_rounding",
 ]
 
 
@@ -136,3 +138,26 @@ def mean_edge_length(V, F):
     F = as_faces(F, len(V))
     E = edges(F)
     return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())
+
+
+#: Relative size below which a value counts as zero to rounding. Rounding positions of size |x| leaves
+#: errors of a few 1e-16 |x| / ell in H ell, K ell^2 or a displacement / ell; 1e-9 is far above that and far
+#: below anything a mesh resolves (K ell^2 = 1e-9 is a sphere of radius 30 000 edges).
+ROUNDING_RTOL = 1e-9
+
+
+def zero_below_rounding(values, scale, rtol=ROUNDING_RTOL):
+    """``values`` with every entry of magnitude at most ``rtol * scale`` set to +0.0; NaN stays NaN.
+
+    Counts and signs of values that are zero to rounding must be zero: a flat mesh
+    has no vertex "with K < 0" and no H of "-0". ``scale`` is the quantity's own
+    size on the mesh, in its units: ``1 / ell`` for H, ``1 / ell**2`` for K, ``ell``
+    for a length (``ell = mean_edge_length(V, F)``).
+
+    Returns
+    -------
+    ndarray of float64, of the shape of ``values`` (a new array).
+    """
+    out = np.array(values, dtype=float)
+    out[np.abs(out) <= rtol * abs(float(scale))] = 0.0
+    return out

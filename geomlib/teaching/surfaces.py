@@ -36,7 +36,7 @@ values against closed forms derived independently.
 Functions: :func:`plane`, :func:`saddle`, :func:`sphere` (icosphere),
 :func:`uv_sphere`, :func:`ellipsoid` (mapped icosphere), :func:`uv_ellipsoid`,
 :func:`torus`, and :func:`attach_truth` for vertices read from a file (for
-instance ``meshes/ellipsoid.obj``).
+instance ``geomlib/meshes/ellipsoid.obj``).
 """
 
 from __future__ import annotations
@@ -867,7 +867,7 @@ def attach_truth(name, V, F, **params):
     Convention as :class:`AnalyticMesh` (outward / upward ``N``, H > 0 on a
     sphere). Use it for meshes read from a file, e.g.
     ``attach_truth("ellipsoid", V, F, a=1.0, b=0.7, c=0.5)`` for
-    ``meshes/ellipsoid.obj``. The truth is evaluated at the parameters of the
+    ``geomlib/meshes/ellipsoid.obj``. The truth is evaluated at the parameters of the
     nearest exact point: the vertices are projected to the surface for the
     evaluation (a file stores about 9 significant digits), while ``V`` is
     returned as given.
