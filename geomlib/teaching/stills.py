@@ -53,9 +53,9 @@ def view_normals(V, F):
     """(n, 3) float64: :func:`geomlib.mesh.geometry.vertex_normals`, with (0, 0, 1) where it has none.
 
     A vertex in no face of non-zero area has no normal (a zero row); a picture
-    must still shade it, and the browser's ``normalize`` of a zero vector is
-    NaN, so the view gives it the normal (0, 0, 1), whose light is as good as
-    any. ``F`` must not hold faces that repeat a vertex (they would have added
+    must still shade it, and the shader's ``normalize`` of a zero vector is
+    undefined, so the view gives it the normal (0, 0, 1), whose light is as
+    good as any. ``F`` must not hold faces that repeat a vertex (they would have added
     nothing).
     """
     N = vertex_normals(V, F)
