@@ -41,13 +41,18 @@
     });
   }
 
+  function gunzip(text) {
+    // base64 of gzip of little-endian 16-bit numbers -> Uint16Array (the browser's own gunzip)
+    var bytes = Uint8Array.from(atob(text), function (c) { return c.charCodeAt(0); });
+    var stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
+    return new Response(stream).arrayBuffer().then(function (buffer) { return new Uint16Array(buffer); });
+  }
+
   function decode(base, encoded, state) {
     // base: the page's own ndarray ({data, shape, stride, offset}); the recorded columns replace its own
     var data = new Float32Array(base.data);
     var width = data.length / base.shape[0];
-    var bytes = atob(state.q);
-    var q = new Uint16Array(bytes.length / 2);
-    for (var b = 0; b < q.length; b++) q[b] = bytes.charCodeAt(2 * b) | (bytes.charCodeAt(2 * b + 1) << 8);
+    var q = state.values;
     var columns = encoded.columns, k = columns.length;
     for (var c = 0; c < k; c++) {
       var lo = state.lo[c], scale = (state.hi[c] - lo) / 65535, col = columns[c];
@@ -65,9 +70,19 @@
       });
     });
     var models = {};
-    return Promise.all(Object.keys(ids).map(function (id) {
+    var loading = Object.keys(ids).map(function (id) {
       return manager.get_model(id).then(function (m) { models[id] = m; });
-    })).then(function () {
+    });
+    groups.forEach(function (group) {
+      group.sliders.forEach(function (s) {
+        s.traits.forEach(function (t) {
+          (t.array ? t.states : []).forEach(function (state) {
+            if (state) loading.push(gunzip(state.q).then(function (q) { state.values = q; }));
+          });
+        });
+      });
+    });
+    return Promise.all(loading).then(function () {
       groups.forEach(function (group) { wireGroup(group, models); });
     });
   }

@@ -18,13 +18,17 @@ own for its sliders to move on the site.
 
 Arrays are stored compactly: only the columns that change during a slider's
 sweep, each column of each state quantised to 16 bits over its own range
-(``lo + q (hi - lo) / 65535``, little-endian, base64). On the scale of a mesh
-that is 1.5e-5 of the column's extent: the picture is the same.
+(``lo + q (hi - lo) / 65535``; little-endian, gzip, base64: the browser unpacks
+gzip itself). On the scale of a mesh that is 1.5e-5 of the column's extent: the
+picture is the same. Per state of a mesh of n vertices that is at most 18 n
+bytes before gzip (positions, normals and colours), against 36 n as float32.
 """
 
 import base64
+import gzip
 import json
 import math
+from collections import deque
 
 import numpy as np
 
@@ -104,9 +108,9 @@ def _reachable(roots):
     """Every widget reachable from ``roots`` through synced traits (children, scene, buffers, ...)."""
     from ipywidgets import Widget
 
-    seen, order, todo = set(), [], list(roots)
-    while todo:
-        item = todo.pop()
+    seen, order, todo = set(), [], deque(roots)
+    while todo:  # breadth first: sliders come in the order a reader sees them
+        item = todo.popleft()
         if isinstance(item, Widget):
             if item.model_id in seen:
                 continue
@@ -151,7 +155,8 @@ def _encode(arrays):
         lo, hi = X.min(axis=0), X.max(axis=0)
         width = np.where(hi > lo, hi - lo, 1.0)
         q = np.rint((X - lo) / width * 65535.0).astype("<u2")
-        states.append({"lo": lo.tolist(), "hi": hi.tolist(), "q": base64.b64encode(q.tobytes()).decode()})
+        data = gzip.compress(q.tobytes(), compresslevel=9, mtime=0)
+        states.append({"lo": lo.tolist(), "hi": hi.tolist(), "q": base64.b64encode(data).decode()})
     return {"shape": list(first.shape), "columns": columns, "states": states}
 
 
