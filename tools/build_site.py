@@ -12,11 +12,35 @@ Jupyter widgets HTML manager and pythreejs's browser code, both served from
 needs no kernel and no network. Links are relative: the folder works from any
 static web server and from ``file://``.
 
-Controls that need a kernel (sliders, dropdowns, ...) are shown disabled at
-their default value, with one line saying that they recompute in JupyterLab.
-A view whose widget state was not saved keeps its still picture; so does a
-live view in a browser without WebGL. A cell that raises does not stop the
-build: its page shows the error and the command exits with status 1.
+Sliders move the 3D views in the page too, with no kernel: their states are
+computed when the site is built. After a cell that shows widgets has run,
+:func:`geomlib.teaching.site_states.record` runs in the same kernel: it sets each
+of the cell's sliders, one at a time from the others' defaults, to a short list
+of values (every integer up to 10, then 15, 20, 30, 50, 100, ...; a long grid
+thinned to about 20 positions, both ends kept: past a stability limit for the
+step sliders), so the notebook's own observers run as when a reader moves the
+slider, and keeps what they changed in the shown widgets (buffer arrays packed
+in 16 bits and gzip, read-out text). The page carries those states as JSON, and
+a small script of the site's own (tools/site_states.js, loaded after the widget
+manager) snaps the slider to the computed values and sets the recorded traits of
+the page's widget models; the 3D views redraw from their buffer models. A line
+under the slider says it snaps. Why this way: it replays exactly what JupyterLab
+shows for those values (the same callbacks, nothing rewritten in JavaScript),
+it needs nothing from the notebooks, and it is one page script of about 150
+lines to keep. Linking the slider to a keyframe animation (ipywidgets.jslink to
+a pythreejs AnimationAction) would also run without a kernel, but a paused
+action does not redraw in the HTML widget manager, and keyframes would have to
+be built per notebook. A slider whose states are too large (over
+``site_states.MAX_BYTES``) or whose moves change nothing the page can replay is
+not precomputed.
+
+Other controls (dropdowns, toggles, checkboxes, and sliders not precomputed)
+are shown disabled at their default value, with one line saying that they
+recompute in JupyterLab. A view whose widget state was not saved keeps its still
+picture; so does a live view in a browser without WebGL. A cell that raises (or
+whose sliders could not be recorded) does not stop the build: its page shows the
+error and the command exits with status 1. The build prints each page's size and
+number of live controls, and the site's total size.
 
 The JavaScript comes from the npm registry, pinned by version and by the
 registry's sha512 integrity hash (:data:`PACKAGES`); downloads are kept in
