@@ -380,6 +380,8 @@ TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
 nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
   font-family: var(--jp-ui-font-family); font-size: 14px; border-bottom: 1px solid #ddd; }
 nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
+/* the output area's style sheet shows its images as blocks, which overrides the hidden attribute */
+img.site-still[hidden] { display: none !important; }
 p.site-kernel-note, p.site-snap-note { font-style: italic; color: #555; margin: 0.2em 0; }
 details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 13px;
   font-family: var(--jp-ui-font-family); margin: 0.3em 0 0.3em 6em; }

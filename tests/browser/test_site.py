@@ -169,9 +169,10 @@ JS_CONTROLS = r"""
 
 # run the page's own check that reveals a still where its view did not draw (normally
 # 30 s after loading); the number of stills then shown
-JS_REVEAL_STILLS = """
-() => { window.siteRevealStills(false); return document.querySelectorAll('img.site-still:not([hidden])').length; }
+JS_SHOWN_STILLS = """
+() => Array.from(document.querySelectorAll('img.site-still')).filter(img => img.getClientRects().length > 0).length
 """
+JS_REVEAL_STILLS = "() => { window.siteRevealStills(false); return (" + JS_SHOWN_STILLS + ")(); }"
 
 # mark the element of every precomputed slider (data-site-slider = its model id) and
 # its cell's output area (data-site-cell); the sliders' descriptions, values and default
@@ -256,7 +257,7 @@ def test_page_offline(notebook, site, site_url, browser):
 
         _check_canvases(page, pages[name]["views"], shots)
 
-        assert page.evaluate(JS_REVEAL_STILLS) == 0, "still pictures shown beside 3D views that drew"
+        assert page.evaluate(JS_REVEAL_STILLS) == 0, "still pictures shown beside 3D views that drew"  # issue 23
 
         controls = page.evaluate(JS_CONTROLS)
         live = len(pages[name]["sliders"])
@@ -340,9 +341,9 @@ def test_stills_show_without_webgl(site, site_url, browser):
         view.page.goto(site_url + name, wait_until="load")
         stills = view.page.locator("img.site-still")
         assert stills.count() > 0, "the page holds no still pictures of its views"
-        assert lablib.wait_for(
-            lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30
-        ), f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
+        assert lablib.wait_for(lambda: view.page.evaluate(JS_SHOWN_STILLS) == stills.count(), 30), (
+            f"{view.page.evaluate(JS_SHOWN_STILLS)} of {stills.count()} stills shown"
+        )
         for i in range(stills.count()):
             assert _not_blank(lablib.stable_screenshot(stills.nth(i))), f"still {i} is blank"
         assert not view.outside, f"requests to the network: {view.outside}"
