@@ -106,3 +106,15 @@ def test_values_a_reader_would_try():
     assert values[0] == pytest.approx(10**tau.min) and values[-1] == pytest.approx(10**tau.max)
     small = ipywidgets.FloatSlider(value=0.1, min=0.0, max=0.4, step=0.05)
     assert slider_values(small) == [0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4]
+
+
+def test_a_plot_in_an_output_widget_is_not_replayed(tmp_path):
+    """The kernel never sees what an Output widget captures: such a slider stays disabled."""
+    a = ipywidgets.FloatSlider(value=1.0, min=0.0, max=2.0, step=0.5, description="a")
+    out = ipywidgets.interactive_output(lambda a: print(a), {"a": a})
+    out.msg_id = ""  # what a kernel's Output does around each capture: it must not count as a change
+    out.observe(lambda change: setattr(out, "msg_id", "capturing"), "outputs")
+    a.observe(lambda change: setattr(out, "msg_id", f"message {change['new']}"), "value")
+    record([ipywidgets.VBox([a, out]).model_id], str(tmp_path / "states.json"))
+    states = json.loads((tmp_path / "states.json").read_text())
+    assert states["sliders"] == [] and states["left_out"][0]["description"] == "a"

@@ -160,6 +160,15 @@ def _encode(arrays):
     return {"shape": list(first.shape), "columns": columns, "states": states}
 
 
+def _replayable(widget):
+    """The synced traits of ``widget`` whose values draw it. Not an Output widget's
+    ``msg_id``: it only says which kernel messages the front-end captures, and the
+    captured outputs themselves never reach the kernel."""
+    import ipywidgets
+
+    return [n for n in widget.keys if not (isinstance(widget, ipywidgets.Output) and n == "msg_id")]
+
+
 def _sweep(slider, values, watched):
     """Set ``slider`` to each value (the default first and last); the changed traits per value.
 
@@ -178,8 +187,9 @@ def _sweep(slider, values, watched):
         column.append(change["new"])
 
     default = slider.value
+    names = {w.model_id: _replayable(w) for w in watched}
     for w in watched:
-        w.observe(note, names=list(w.keys))
+        w.observe(note, names=names[w.model_id])
     try:
         for j, v in enumerate(values):
             current["j"] = j
@@ -188,7 +198,7 @@ def _sweep(slider, values, watched):
                 column.extend([column[-1]] * (j + 1 - len(column)))
     finally:
         for w in watched:
-            w.unobserve(note, names=list(w.keys))
+            w.unobserve(note, names=names[w.model_id])
         slider.value = default  # the observers put the default state back
     return seen
 
