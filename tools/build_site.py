@@ -13,9 +13,9 @@ needs no kernel and no network. Links are relative: the folder works from any
 static web server and from ``file://``.
 
 Sliders move the 3D views in the page too, with no kernel: their states are
-computed when the site is built. After a cell that shows widgets has run,
-:func:`geomlib.teaching.site_states.record` runs in the same kernel: it sets each
-of the cell's sliders, one at a time from the others' defaults, to a short list
+computed when the site is built. After the notebook's last cell has run,
+:func:`geomlib.teaching.site_states.record` runs in the same kernel for every cell
+that showed widgets: it sets each of the cell's sliders, from the value it was left at, one at a time from the others' defaults, to a short list
 of values (every integer up to 10, then 15, 20, 30, 50, 100, ...; a long grid
 thinned to about 20 positions, both ends kept: past a stability limit for the
 step sliders), so the notebook's own observers run as when a reader moves the
@@ -205,8 +205,9 @@ def _shown(cell):
 def execute(path, timeout=1200):
     """Run the notebook at ``path`` top to bottom in its folder; the widget state is stored.
 
-    After every cell that displays widgets, :func:`geomlib.teaching.site_states.record`
-    runs in the same kernel and records the states of the cell's sliders. Returns
+    After the last cell, :func:`geomlib.teaching.site_states.record` runs in the same
+    kernel for every cell that displayed widgets and records the states of its
+    sliders, from the values they were left at. Returns
     ``(nb, recorded)`` with ``recorded`` mapping a cell's index to what was recorded
     (``{"sliders": [...], "left_out": [...]}``, or ``{"error": text}``).
 
@@ -224,24 +225,32 @@ def execute(path, timeout=1200):
         allow_errors=True,
         resources={"metadata": {"path": str(path.parent)}},
     )
-    recorded = {}
+    # the sliders are recorded after the last cell, in the state the page is saved in (a
+    # later cell may move a slider, and moving one after "Run all" in JupyterLab runs its
+    # callback in that final namespace too): a cell added at the end, removed afterwards
+    nb.cells.append(nbformat.v4.new_code_cell("None  # the site's slider states are recorded after this cell"))
+    last = len(nb.cells) - 1
+    shown, recorded = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
 
         async def record_sliders(cell, cell_index, execute_reply):
-            ids = _shown(cell)
-            if not ids:
+            if cell_index != last:
+                if _shown(cell):
+                    shown[cell_index] = _shown(cell)
                 return
-            target = Path(tmp) / f"{cell_index}.json"
-            # a call that leaves no name behind in the reader's namespace
-            probe = nbformat.v4.new_code_cell(
-                f"__import__('geomlib.teaching.site_states', fromlist=['record']).record({ids!r}, {str(target)!r})"
-            )
-            await client.async_execute_cell(probe, cell_index, store_history=False)
-            errors = [f"{o['ename']}: {o['evalue']}" for o in probe.outputs if o.get("output_type") == "error"]
-            recorded[cell_index] = {"error": "; ".join(errors)} if errors else json.loads(target.read_text())
+            for i, ids in shown.items():
+                target = Path(tmp) / f"{i}.json"
+                # a call that leaves no name behind in the reader's namespace
+                probe = nbformat.v4.new_code_cell(
+                    f"__import__('geomlib.teaching.site_states', fromlist=['record']).record({ids!r}, {str(target)!r})"
+                )
+                await client.async_execute_cell(probe, cell_index, store_history=False)
+                errors = [f"{o['ename']}: {o['evalue']}" for o in probe.outputs if o.get("output_type") == "error"]
+                recorded[i] = {"error": "; ".join(errors)} if errors else json.loads(target.read_text())
 
         client.on_cell_executed = record_sliders
         client.execute()
+    nb.cells.pop()
     return nb, recorded
 
 

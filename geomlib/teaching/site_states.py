@@ -1,8 +1,8 @@
 """The states of a cell's sliders, computed ahead for the static website.
 
 The site builder (``tools/build_site.py``) runs every notebook in a kernel.
-After a cell that shows sliders has run, it calls :func:`record` in that same
-kernel with the ids of the widgets the cell displayed. ``record`` moves each
+After the last cell, it calls :func:`record` in that same kernel, once per cell
+that showed widgets, with the ids of the widgets the cell displayed. ``record`` moves each
 slider, one at a time from the defaults of the others, through a short list of
 values (:func:`slider_values`). Setting ``slider.value`` in the kernel runs the
 notebook's own observers exactly as when a reader moves the slider in

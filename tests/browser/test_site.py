@@ -39,6 +39,7 @@ import os
 import re
 import sys
 import threading
+import time
 from pathlib import Path
 
 import lablib
@@ -175,7 +176,7 @@ JS_SHOWN_STILLS = """
 JS_REVEAL_STILLS = "() => { window.siteRevealStills(false); return (" + JS_SHOWN_STILLS + ")(); }"
 
 # mark the element of every precomputed slider (data-site-slider = its model id) and
-# its cell's output area (data-site-cell); the sliders' descriptions, values and default
+# its cell's output area (data-site-cell-<model id>); the sliders' descriptions, values and default
 JS_MARK_SLIDERS = """
 async () => {
   const out = [];
@@ -184,7 +185,7 @@ async () => {
       const views = await Promise.all(Object.values(s.model.views));
       const el = views.map(v => v.el).find(el => el.isConnected);
       el.setAttribute('data-site-slider', s.model_id);
-      el.closest('.jp-OutputArea-output').setAttribute('data-site-cell', s.model_id);
+      el.closest('.jp-OutputArea-output').setAttribute('data-site-cell-' + s.model_id, '');  // a cell has several
       out.push({id: s.model_id, description: s.description, values: s.values, default: s.default});
     }
   }
@@ -365,6 +366,7 @@ def _pictures(canvases):
 
 
 def _press(page, handle, key, slider_id, index):
+    time.sleep(0.3)  # a reader's pace: key presses faster than the slider's frame can leave its read-out behind
     handle.press(key)
     at = f"() => window.siteStates.flatMap(g => g.sliders).find(s => s.model_id === '{slider_id}').current"
     assert lablib.wait_for(lambda: page.evaluate(at) == index, 20), f"{key}: the slider is at state {page.evaluate(at)}"
@@ -389,7 +391,7 @@ def test_precomputed_sliders_move_the_views(name, site, site_url, browser):
         sliders = page.evaluate(JS_MARK_SLIDERS)
         assert len(sliders) == len(pages[name]["sliders"])
         for s in sliders:
-            cell = page.locator(f'[data-site-cell="{s["id"]}"]')
+            cell = page.locator(f"[data-site-cell-{s['id']}]")
             canvases = cell.locator("canvas")
             assert lablib.wait_for(lambda: canvases.count() > 0, LOAD_TIMEOUT), f"{s['description']}: no view"
             before, text = _pictures(canvases), cell.inner_text()
