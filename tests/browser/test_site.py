@@ -39,7 +39,6 @@ import os
 import re
 import sys
 import threading
-import time
 from pathlib import Path
 
 import lablib
@@ -366,7 +365,6 @@ def _pictures(canvases):
 
 
 def _press(page, handle, key, slider_id, index):
-    time.sleep(0.3)  # a reader's pace: key presses faster than the slider's frame can leave its read-out behind
     handle.press(key)
     at = f"() => window.siteStates.flatMap(g => g.sliders).find(s => s.model_id === '{slider_id}').current"
     assert lablib.wait_for(lambda: page.evaluate(at) == index, 20), f"{key}: the slider is at state {page.evaluate(at)}"
