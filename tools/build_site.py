@@ -228,7 +228,8 @@ def execute(path, timeout=1200):
     # the sliders are recorded after the last cell, in the state the page is saved in (a
     # later cell may move a slider, and moving one after "Run all" in JupyterLab runs its
     # callback in that final namespace too): a cell added at the end, removed afterwards
-    nb.cells.append(nbformat.v4.new_code_cell("None  # the site's slider states are recorded after this cell"))
+    after_all = nbformat.v4.new_code_cell("None  # the site's slider states are recorded after this cell")
+    nb.cells.append(after_all)
     last = len(nb.cells) - 1
     shown, recorded = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -237,6 +238,8 @@ def execute(path, timeout=1200):
             if cell_index != last:
                 if _shown(cell):
                     shown[cell_index] = _shown(cell)
+                return
+            if cell is not after_all:  # one of the calls below
                 return
             for i, ids in shown.items():
                 target = Path(tmp) / f"{i}.json"
