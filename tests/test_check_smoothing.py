@@ -46,6 +46,13 @@ STEP_MISTAKES = {
 }
 
 
+@pytest.mark.parametrize("name", STEP_MISTAKES)
+def test_a_step_mistake_the_check_names_earns_partial_credit(name):
+    wrong, _ = STEP_MISTAKES[name]
+    earned = check.explicit_step.partial_credit(wrong).passed
+    assert earned == (name not in ("one coordinate", "something else")), check.explicit_step(wrong).message
+
+
 def on_matrices(wrong):
     """A learner's fn(V, F) that builds (M, C) and then makes the mistake ``wrong(M, C)``."""
     return lambda V, F: wrong(*laplacian(V, F))

@@ -112,3 +112,7 @@ def test_course_meshes():
         DENOISE_ITERATIONS=50,
     )
     assert "CAD mesh** (7229 vertices)" in run.outputs_text()
+    # the noisy "clean" part is detected and said so, at the notebook's fixed probe level whatever SIGMAS is
+    assert "the 'clean' mesh is itself about as rough as a noisy one" in "\n".join(run.notes)
+    assert "The reference itself is noisy** for the CAD mesh" in run.outputs_text()
+    assert "the clean smooth mesh" not in "\n".join(run.notes)  # the bunny is not flagged

@@ -1,4 +1,4 @@
-"""Tests of geomlib.teaching.viewer: colour mapping, in-place updates, normals, the still
+"""Tests of the 3D views (geomlib.teaching.viewer, .colours, .stills): colour mapping, in-place updates, normals, the still
 picture in the display bundle, linked cameras and input checks.
 
 The browser side (does the canvas really show the mesh, does a slider change
@@ -17,15 +17,9 @@ import trimesh
 from PIL import Image
 
 from geomlib import MeshError
-from geomlib.teaching.viewer import (
-    NAN_COLOR,
-    MeshView,
-    colorize,
-    render_still,
-    side_by_side,
-    value_range,
-    vertex_normals_fast,
-)
+from geomlib.teaching.colours import NAN_COLOR, colorize, value_range
+from geomlib.teaching.stills import render_still, vertex_normals_fast
+from geomlib.teaching.viewer import MeshView, side_by_side, stills_only
 
 
 @pytest.fixture(scope="module")
@@ -212,9 +206,9 @@ def test_mimebundle_has_widget_png_and_text(sphere):
 
 def test_still_puts_the_mesh_in_the_middle():
     # a unit square facing the camera direction fills the middle, corners stay background
-    from geomlib.teaching.viewer import UP, VIEW_DIRECTION, _basis
+    from geomlib.teaching.stills import UP, VIEW_DIRECTION, camera_basis
 
-    right, up, w = _basis(VIEW_DIRECTION, UP)
+    right, up, w = camera_basis(VIEW_DIRECTION, UP)
     corners = np.array([-right - up, right - up, right + up, -right + up])
     F = np.array([[0, 1, 2], [0, 2, 3]])
     colors = np.tile([1.0, 0.0, 0.0], (4, 1))
@@ -231,6 +225,24 @@ def test_still_puts_the_mesh_in_the_middle():
     # whatever the order of the faces
     image3 = render_still(V2, F2[::-1], colors2, width=100, height=80)
     assert (image3 == image2).all()
+
+
+def _word_gaps(title):
+    """Widths of the blank column runs between the inked columns of a still's title line."""
+    from geomlib.teaching.stills import still_with_colorbar
+
+    image = still_with_colorbar(np.full((20, 400, 3), 255, np.uint8), None, 0.0, 1.0, "", title)
+    ink = (image[:18] < 128).any(axis=(0, 2))  # the title band above the picture
+    columns = np.flatnonzero(ink)
+    runs = np.diff(columns) - 1
+    return runs[runs > 0]
+
+
+def test_still_titles_keep_their_spaces():
+    # Pillow's default font has a 2 px space that hinting can remove ("implicitsmoothing")
+    spaced, joined = _word_gaps("implicit smoothing, steps of 0.3"), _word_gaps("implicitsmoothing,stepsof0.3")
+    assert (spaced >= 3).sum() == 4  # the four spaces, each at least 3 px wide
+    assert (joined >= 3).sum() == 0  # letters within a word are never that far apart
 
 
 def test_plain_view_without_values(sphere):
@@ -267,6 +279,20 @@ def test_side_by_side_links_cameras(sphere):
     image = _decode(bundle)
     assert image.shape[1] == 3 * a.width + 2 * 8
     assert bundle["text/plain"].count("MeshView") == 3
+
+
+def test_while_nbgrader_runs_a_view_is_its_still_without_the_widget(sphere, monkeypatch):
+    # nbgrader's feedback pages are static HTML: a widget there is an empty placeholder
+    V, F = sphere
+    monkeypatch.delenv("NBGRADER_EXECUTION", raising=False)
+    assert not stills_only()
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    assert stills_only()
+    view = MeshView(V, F, title="sphere")
+    row = side_by_side(view, MeshView(V, F))
+    for bundle in (view._repr_mimebundle_(), row._repr_mimebundle_()):
+        assert set(bundle) == {"image/png", "text/plain"}
+        assert _decode(bundle).shape[1] >= view.width
 
 
 def test_side_by_side_without_linking_keeps_cameras(sphere):
@@ -349,7 +375,7 @@ def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
 
 
 def test_a_field_zero_up_to_rounding_draws_white(sphere):
-    from geomlib.teaching.viewer import ZERO_COLOR
+    from geomlib.teaching.colours import ZERO_COLOR
 
     V, F = sphere
     rounding = 8e-13 * np.sin(7 * V[:, 0])  # a flat mesh's H, say: zero but for rounding

@@ -14,7 +14,7 @@ eigenvectors are the normalised indicator functions of the components
 (largest area first); each component then has its own spectrum.
 
 How it is solved (:func:`eigenbasis`): ``M^-1 C`` is not symmetric, so with
-``D = M^1/2`` the problem becomes ``S y = lam y``, ``S = -D^-1 C D^-1``,
+``D = M^1/2`` the problem becomes ``Q y = lam y``, ``Q = -D^-1 C D^-1``,
 ``e = D^-1 y`` (Vallet and Levy 2008), handed to
 :func:`geomlib.numerics.eigen.smallest_eigenpairs` (dense LAPACK for small meshes,
 ARPACK shift-invert Lanczos on one sparse Cholesky factorisation otherwise).
@@ -57,7 +57,7 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cach
     """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
 
     ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
-    Solved in the symmetric form ``S y = lam y`` with ``S = -M^-1/2 C M^-1/2``
+    Solved in the symmetric form ``Q y = lam y`` with ``Q = -M^-1/2 C M^-1/2``
     and ``e = M^-1/2 y`` (Vallet and Levy 2008): dense LAPACK for small meshes,
     ARPACK shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) on one sparse
     Cholesky factorisation otherwise (:mod:`geomlib.numerics.eigen`).
@@ -120,9 +120,9 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cach
     M, C = laplacian(V, F, weights=weights, area=area)
     m = positive_vertex_areas(M, F, "eigenbasis")
     D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
-    S = D_inv @ (-C) @ D_inv  # symmetric PSD: S y = lam y
+    Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q y = lam y (notebook 04's symbol)
     shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
-    lam, Y = smallest_eigenpairs(S.tocsr(), k, shift, _METHODS[method], tol or 0.0)
+    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol or 0.0)
     E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
     return _tidy(lam, E, m, F)
 

@@ -8,8 +8,10 @@
   faces that repeat a vertex. The message names the problem and the offending
   vertex or face indices. They cost O(n + m) vectorised work and never copy
   arrays that already have the right dtype and layout.
-* :func:`is_zero_area` is the package's one test for a zero-area triangle and
-  :func:`zero_area_faces` lists them.
+* :func:`is_zero_area` is the package's one test for a zero-area triangle
+  (:func:`geomlib.mesh.geometry.zero_area_faces` lists them).
+* :func:`check_choice` is the package's one check of an option that takes one
+  of a few named values (``weights=``, ``area=``, ``scheme=``, ...).
 
 The report of mesh properties that do not stop a computation (boundaries,
 non-manifold parts, components, ...) is :func:`geomlib.mesh.report.check_mesh`.
@@ -21,7 +23,7 @@ import numpy as np
 
 from .errors import MeshError, count_text, format_indices
 
-__all__ = ["as_mesh", "as_faces", "as_vertices", "is_zero_area", "ZERO_AREA_RTOL"]
+__all__ = ["as_mesh", "as_faces", "as_vertices", "is_zero_area", "check_choice", "ZERO_AREA_RTOL"]
 
 # A face counts as zero-area when twice its area is at most this fraction of
 # its longest edge squared, i.e. its height over the longest edge is below
@@ -187,3 +189,15 @@ def is_zero_area(dblA, longest2, rtol=ZERO_AREA_RTOL):
     squared (arrays of the same shape); returns a boolean array.
     """
     return dblA <= rtol * longest2
+
+
+def check_choice(name, value, choices):
+    """Return ``value`` if it is one of ``choices``; otherwise raise MeshError naming the option, the value and the choices.
+
+    >>> check_choice("weights", "cotan", ("cotan", "uniform"))
+    'cotan'
+    """
+    if isinstance(value, str) and value in choices:  # `in` on a non-string (an array) would compare elementwise
+        return value
+    listed = ", ".join(repr(c) for c in choices)
+    raise MeshError(f"{name} must be one of {listed}, not {value!r}")
