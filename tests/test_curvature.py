@@ -4,13 +4,12 @@ import warnings
 
 import numpy as np
 import pytest
-from meshdata import COURSE, COURSE_MESHES, SHIPPED, needs_course
+from meshdata import COURSE, COURSE_MESHES, SHIPPED, load_quietly, needs_course
 
 from geomlib import (
     MeshError,
     MeshWarning,
     gaussian_curvature,
-    load_mesh,
     mean_curvature,
     principal_curvatures,
     surfaces,
@@ -321,17 +320,13 @@ def test_libigl_gaussian_curvature_generated(name):
 
 @pytest.mark.parametrize("name", sorted(p.name for p in SHIPPED.glob("*.obj")))
 def test_libigl_gaussian_curvature_shipped(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        _against_libigl(*load_mesh(SHIPPED / name))
+    _against_libigl(*load_quietly(SHIPPED / name))
 
 
 @needs_course
 @pytest.mark.parametrize("name", COURSE_MESHES)
 def test_libigl_gaussian_curvature_course(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        V, F = load_mesh(COURSE / name)
+    V, F = load_quietly(COURSE / name)
     _against_libigl(V, F)
     # Gauss-Bonnet with the turning angle on every course mesh, open or closed
     total = gaussian_curvature(V, F, boundary="turning", integrated=True)

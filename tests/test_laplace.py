@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import trimesh
-from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, needs_course
+from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, load_quietly, needs_course
 
-from geomlib import MeshError, MeshWarning, laplacian, load_mesh, surfaces, vertex_areas
+from geomlib import MeshError, MeshWarning, laplacian, surfaces, vertex_areas
 from geomlib.lessons.laplace import (
     barycentric_areas,
     cotangent_matrix,
@@ -295,17 +295,13 @@ def test_libigl_generated(name):
 
 @pytest.mark.parametrize("name", SHIPPED_MESHES)
 def test_libigl_shipped_meshes(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        _against_libigl(*load_mesh(SHIPPED / name))
+    _against_libigl(*load_quietly(SHIPPED / name))
 
 
 @needs_course
 @pytest.mark.parametrize("name", COURSE_MESHES)
 def test_libigl_course_meshes(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        _against_libigl(*load_mesh(COURSE / name))
+    _against_libigl(*load_quietly(COURSE / name))
 
 
 # ---------------------------------------------------------------- the teaching functions one by one

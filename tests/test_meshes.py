@@ -1,4 +1,4 @@
-"""Tests of the shipped meshes (meshes/*.obj, meshes/README.md) and their generator."""
+"""Tests of the shipped meshes (geomlib/meshes/*.obj, geomlib/meshes/README.md) and their generator."""
 
 import importlib.util
 import re
@@ -57,7 +57,7 @@ def load(name):
 
 
 def readme_table():
-    """{file: {column: text}} from the table in meshes/README.md."""
+    """{file: {column: text}} from the table in geomlib/meshes/README.md."""
     lines = [ln for ln in (MESHES / "README.md").read_text().splitlines() if ln.startswith("|")]
     head = [c.strip() for c in lines[0].strip("|").split("|")]
     rows = {}

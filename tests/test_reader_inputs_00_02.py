@@ -9,27 +9,13 @@ Notebook 01 and 00 share the cleaning step (geomlib.mesh.repair.prepare), so the
 import json
 
 import numpy as np
-import pytest
 import sympy as sp
-from awkward_meshes import make_all
 from meshdata import COURSE, ROOT, needs_course
-from notebook_runner import Raw, run_notebook
+from notebook_runner import Raw, ran
 
 from geomlib.teaching import surfaces
 
 NB00, NB01, NB02 = "00_getting_started.ipynb", "01_uniform_laplace_curvature.ipynb", "02_fundamental_forms.ipynb"
-
-
-@pytest.fixture(scope="module")
-def awkward(tmp_path_factory):
-    return {name: str(path) for name, path in make_all(tmp_path_factory.mktemp("awkward")).items()}
-
-
-def ran(name, **parameters):
-    run = run_notebook(name, **parameters)
-    run.assert_ran()
-    print(f"{name} {parameters}: {run.seconds:.1f} s, {len(run.notes)} notes")
-    return run
 
 
 def test_saddle_height_stated_in_01_is_the_code():

@@ -7,25 +7,15 @@ components, a large CUBE, steps past every limit, absolute and scale-free units)
 """
 
 import pytest
-from awkward_meshes import make_all
 from meshdata import COURSE, needs_course
-from notebook_runner import run_notebook
+from notebook_runner import ran
 
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def awkward(tmp_path_factory):
-    return {name: str(path) for name, path in make_all(tmp_path_factory.mktemp("awkward")).items()}
-
-
-def notes_of(run):
-    return "\n".join(run.notes)
-
-
 @needs_course
 def test_05_course_meshes_with_the_assignments_absolute_step():
-    run = run_notebook(
+    run = ran(
         "05_explicit_smoothing.ipynb",
         PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
         PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
@@ -36,8 +26,7 @@ def test_05_course_meshes_with_the_assignments_absolute_step():
         ITERATIONS=0,
         CUBE_STEPS=1,
     )
-    run.assert_ran()
-    text, notes = run.outputs_text(), notes_of(run)
+    text, notes = run.outputs_text(), run.notes_text()
     # the conversion table: 1e-5 is 0.0278 of fandisk_ns's limit and 2.1 times plane_ns's
     assert "| part | assignment's 1e-05 | 1e-05 | 0.000833 | 0.02782 |" in text
     assert "| plane | assignment's 1e-06 | 1e-06 | 0.03545 | 0.2118 |" in text
@@ -54,7 +43,7 @@ def test_05_course_meshes_with_the_assignments_absolute_step():
 @needs_course
 def test_05_one_step_per_mesh_runs_the_assignments_task_5_in_one_go():
     # task 5: explicit 1e-4 on fandisk_ns and 1e-6 on plane_ns; one STEP for both made the plane diverge
-    run = run_notebook(
+    run = ran(
         "05_explicit_smoothing.ipynb",
         PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
         PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
@@ -65,8 +54,7 @@ def test_05_one_step_per_mesh_runs_the_assignments_task_5_in_one_go():
         ITERATIONS=50,
         CUBE_STEPS=1,
     )
-    run.assert_ran()
-    text, notes = run.outputs_text(), notes_of(run)
+    text, notes = run.outputs_text(), run.notes_text()
     assert "| plane | STEP = 1e-06 length^2 | 1e-06 | 0.03545 | 0.2118 |" in text
     assert "| part | STEP = 0.0001 length^2 | 0.0001 | 0.00833 | 0.2782 |" in text
     assert "| cube | STEP = 1e-06 length^2 |" in text  # left out of the dict: the smallest step given
@@ -78,7 +66,7 @@ def test_05_one_step_per_mesh_runs_the_assignments_task_5_in_one_go():
 
 
 def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
-    run = run_notebook(
+    run = ran(
         "05_explicit_smoothing.ipynb",
         PLANE=awkward["y_up_millimetres"],
         PART=awkward["two_components"],
@@ -89,8 +77,7 @@ def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
         ITERATIONS=1000,
         CUBE_STEPS=50,
     )
-    run.assert_ran()
-    notes = notes_of(run)
+    notes = run.notes_text()
     assert "2 connected components" in notes and "largest_component" in notes
     assert "CUBE has 6209 vertices" in notes
     assert "past the cotangent limit on cube, plane, part" in notes
@@ -101,7 +88,7 @@ def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
 
 @needs_course
 def test_06_course_meshes_with_the_assignments_absolute_step():
-    run = run_notebook(
+    run = ran(
         "06_implicit_smoothing.ipynb",
         PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
         PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
@@ -110,7 +97,6 @@ def test_06_course_meshes_with_the_assignments_absolute_step():
         ITERATIONS=1,
         SMOOTHING_TIME=0.1,
     )
-    run.assert_ran()
     text = run.outputs_text()
     assert "| part | assignment's 1e-05 | | | | 1e-05 | 0.000833 | 0.02782 |" in text
     # T = 0.1 ell^2 takes 4 explicit steps, each near the limit: they damp the top mode less than usual
@@ -119,7 +105,7 @@ def test_06_course_meshes_with_the_assignments_absolute_step():
 
 @needs_course
 def test_06_one_step_per_mesh():
-    run = run_notebook(
+    run = ran(
         "06_implicit_smoothing.ipynb",
         PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
         PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
@@ -128,7 +114,6 @@ def test_06_one_step_per_mesh():
         ITERATIONS=1,
         SMOOTHING_TIME=0.1,
     )
-    run.assert_ran()
     text = run.outputs_text()
     assert "| 1e-06 | 0.03545 | 0.2118 |" in text and "| 0.0001 | 0.00833 | 0.2782 |" in text
     assert "steps of STEP = {CUBE: 1e-06, PLANE: 1e-06, PART: 0.0001, SPHERE: 1e-06} (length^2)" in text
@@ -136,7 +121,7 @@ def test_06_one_step_per_mesh():
 
 
 def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
-    run = run_notebook(
+    run = ran(
         "06_implicit_smoothing.ipynb",
         PLANE=awkward["scan_with_holes"],
         PART=awkward["scan_with_holes"],
@@ -146,8 +131,7 @@ def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
         ITERATIONS=50,
         SMOOTHING_TIME=100.0,
     )
-    run.assert_ran()
-    notes = notes_of(run)
+    notes = run.notes_text()
     assert "not used by any face" in notes and "remove_unreferenced_vertices" in notes
     assert "2 connected components" in notes and "largest_component" in notes
     assert "PART is open: it encloses no volume" in notes

@@ -17,8 +17,9 @@ import trimesh
 from PIL import Image
 
 from geomlib import MeshError
+from geomlib.mesh.geometry import vertex_normals
 from geomlib.teaching.colours import NAN_COLOR, colorize, value_range
-from geomlib.teaching.stills import render_still, vertex_normals_fast
+from geomlib.teaching.stills import render_still, view_normals
 from geomlib.teaching.viewer import MeshView, side_by_side, stills_only
 
 
@@ -156,26 +157,36 @@ def test_auto_range_follows_values(sphere):
 # --- normals ----------------------------------------------------------------
 
 
-def test_normals_on_a_sphere_are_radial():
+def test_view_normals_are_geometry_vertex_normals():
+    """The view draws with the mesh core's vertex normals, before and after an update (one home)."""
     m = trimesh.creation.icosphere(subdivisions=4, radius=1.0)  # 2562 vertices
     V, F = np.asarray(m.vertices), np.asarray(m.faces)
-    radial = V / np.linalg.norm(V, axis=1, keepdims=True)
-    N = vertex_normals_fast(V, F)
-    assert np.abs(N - radial).max() < 1e-2
-    np.testing.assert_allclose(np.linalg.norm(N, axis=1), 1.0, atol=1e-12)
     view = MeshView(V, F)
-    assert np.abs(view.normals - radial).max() < 1e-2
-    # moving the vertices moves the normals: an ellipsoid's normal is grad(x^2/a^2 + ...)
+    np.testing.assert_allclose(view.normals, vertex_normals(V, F), atol=1e-6)  # float32 buffer
     E = V * [1.0, 2.0, 3.0]
     view.update(V=E)
+    np.testing.assert_allclose(view.normals, vertex_normals(E, F), atol=1e-6)
+    # and they are the normals of the surface drawn: an ellipsoid's normal is grad(x^2/a^2 + ...)
     g = E / np.array([1.0, 4.0, 9.0])
     g /= np.linalg.norm(g, axis=1, keepdims=True)
     assert np.abs(view.normals - g).max() < 5e-2
 
 
-def test_normals_flip_with_orientation(sphere):
-    V, F = sphere
-    np.testing.assert_allclose(vertex_normals_fast(V, F[:, ::-1]), -vertex_normals_fast(V, F), atol=1e-12)
+def test_a_vertex_without_normal_is_lit_from_up_and_repeated_faces_draw_nothing():
+    # two triangles, a face repeating a vertex, an isolated vertex 4 and vertex 5 only in a zero-area face
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5], [3, 3, 3], [2, 0, 0]], dtype=np.float64)
+    F = np.array([[0, 1, 2], [1, 3, 2], [2, 2, 1], [0, 1, 5]])
+    view = MeshView(V, F)
+    triangles = F[[0, 1, 3]]
+    expected = vertex_normals(V, triangles)
+    np.testing.assert_array_equal(expected[[4, 5]], 0.0)  # the mesh core gives no normal there
+    expected[[4, 5]] = (0.0, 0.0, 1.0)
+    np.testing.assert_allclose(view.normals, expected, atol=1e-6)
+    np.testing.assert_allclose(view_normals(V, triangles), expected)
+    assert view.F.shape == (4, 3)  # the repeated face is kept in the drawing, where it covers no pixel
+    assert view.still().shape[1] == view.width
+    with pytest.raises(MeshError, match="every face of F repeats a vertex"):
+        MeshView(V, F[[2]])
 
 
 # --- display ----------------------------------------------------------------
@@ -359,6 +370,20 @@ def test_values_of_wrong_length(sphere):
         MeshView(V, F, values=V[:, 0], cmap="no-such-map")
     with pytest.raises(MeshError, match="MeshView"):
         side_by_side(view, "not a view")
+
+
+def test_closed_outward_takes_the_mesh_cores_volume(sphere, monkeypatch):
+    import geomlib.teaching.viewer as viewer
+
+    V, F = sphere
+    monkeypatch.setattr(viewer, "enclosed_volume", lambda V, F: -1.0)
+    assert MeshView(V, F).mesh.material.side == "DoubleSide"
+
+
+def test_up_is_checked_as_every_option(sphere):
+    V, F = sphere
+    with pytest.raises(MeshError, match=r"up must be one of 'z', 'y', 'x', not 'w'"):
+        MeshView(V, F, up="w")
 
 
 def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):

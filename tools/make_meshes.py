@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Make the meshes the workbook ships (meshes/*.obj and meshes/README.md).
+"""Make the meshes the workbook ships (geomlib/meshes/*.obj and geomlib/meshes/README.md).
 
-    python tools/make_meshes.py                 # every mesh, then meshes/README.md
+    python tools/make_meshes.py                 # every mesh, then geomlib/meshes/README.md
     python tools/make_meshes.py --only sphere   # some of them (README from the files present)
     python tools/make_meshes.py --out DIR       # somewhere else
 

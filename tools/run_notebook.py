@@ -302,7 +302,7 @@ def parse_value(text, spec):
 def read_assignments(notebook, parameters, args, cwd):
     """The values ``args`` (``NAME=VALUE``, ...) give, checked against the notebook's ranges.
 
-    A relative path is made absolute against ``cwd`` (the kernel runs in the run's folder).
+    A relative path is made absolute against ``cwd`` (the kernel runs in the notebook's folder, the paths are the reader's).
     Raises UsageError with one sentence when a name or value is not allowed.
     """
     by_name = {p.name: p for p in parameters}
@@ -367,7 +367,7 @@ def run(notebook, values, timeout=3600):
             executed,
             parameters=for_papermill(values),
             kernel_name="python3",
-            cwd=folder,  # whatever the notebook writes stays with the run
+            cwd=notebook.parent,  # as in Jupyter: the notebook's own folder (03 and 04 read ../benchmarks)
             progress_bar=False,
             execution_timeout=timeout,
             # the kernel's start-up log (a warning about its local TCP sockets) is not the reader's business

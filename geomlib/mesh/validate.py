@@ -23,7 +23,15 @@ import numpy as np
 
 from .errors import MeshError, count_text, format_indices
 
-__all__ = ["as_mesh", "as_faces", "as_vertices", "is_zero_area", "check_choice", "ZERO_AREA_RTOL"]
+__all__ = [
+    "as_mesh",
+    "as_faces",
+    "as_vertices",
+    "repeated_vertex_faces",
+    "is_zero_area",
+    "check_choice",
+    "ZERO_AREA_RTOL",
+]
 
 # A face counts as zero-area when twice its area is at most this fraction of
 # its longest edge squared, i.e. its height over the longest edge is below
@@ -60,7 +68,7 @@ def _as_int_array(F, label, where):
     raise MeshError(f"{_prefix(where)}{label} has dtype {F.dtype}; face indices must be integers")
 
 
-def as_faces(F, n=None, *, where=None, allow_empty=False):
+def as_faces(F, n=None, *, where=None, allow_empty=False, allow_repeated=False):
     """Validate a face array: (m, 3) int64, C-contiguous, 0-based.
 
     Parameters
@@ -75,6 +83,9 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
         Prefix for error messages (a file name, an argument name).
     allow_empty : bool
         Accept ``m = 0``.
+    allow_repeated : bool
+        Accept faces that repeat a vertex (for a drawing, where such a face is
+        simply invisible; every computation refuses them).
 
     Returns
     -------
@@ -85,7 +96,8 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
     ------
     MeshError
         Wrong shape or dtype; indices out of range (the faces, the bad index
-        and the vertex count are named); faces that repeat a vertex.
+        and the vertex count are named); faces that repeat a vertex (unless
+        ``allow_repeated``).
     """
     F = _as_int_array(F, "F", where)
     if F.ndim != 2 or F.shape[1] != 3:
@@ -104,15 +116,19 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
         raise MeshError(
             f"{_prefix(where)}face indices out of range (valid: {valid}): {detail}{more}; faces {format_indices(rows)}"
         )
-    rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-    if rep.any():
-        rows = np.flatnonzero(rep)
+    rows = [] if allow_repeated else repeated_vertex_faces(F)
+    if len(rows):
         detail = ", ".join(f"face {r} = {F[r].tolist()}" for r in rows[:5])
         raise MeshError(
             f"{_prefix(where)}{count_text(rows, 'face repeats', 'faces repeat')} a vertex (no triangle): {detail}; "
             f"faces {format_indices(rows)}"
         )
     return F
+
+
+def repeated_vertex_faces(F):
+    """Indices (k,) int64 of the faces that repeat a vertex (no triangle); ``F`` an (m, 3) integer array."""
+    return np.flatnonzero((F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0]))
 
 
 def as_vertices(V, *, where=None):

@@ -12,8 +12,8 @@ import base64
 import io
 
 import numpy as np
-import scipy.sparse as sp
 
+from ..mesh.geometry import bounding_box_diagonal, vertex_normals
 from .colours import format_value
 
 __all__ = [
@@ -21,10 +21,7 @@ __all__ = [
     "UP",
     "VIEW_DIRECTION",
     "FOV",
-    "corner_matrix",
-    "face_normal_sums",
-    "normalise_rows",
-    "vertex_normals_fast",
+    "view_normals",
     "bounding_frame",
     "camera_distance",
     "camera_basis",
@@ -48,64 +45,22 @@ FOV = 30.0
 
 
 # ----------------------------------------------------------------------------
-# vertex normals (pure functions, vectorised)
+# vertex normals of a view
 # ----------------------------------------------------------------------------
 
 
-def corner_matrix(F, n):
-    """Sparse (n, m) 0/1 matrix S with S[i, f] = 1 when vertex i is a corner of f."""
-    m = F.shape[0]
-    rows = F.ravel()
-    cols = np.repeat(np.arange(m), 3)
-    return sp.csr_matrix((np.ones(3 * m, dtype=np.float64), (rows, cols)), shape=(n, m))
+def view_normals(V, F):
+    """(n, 3) float64: :func:`geomlib.mesh.geometry.vertex_normals`, with (0, 0, 1) where it has none.
 
-
-def face_normal_sums(P, Fc, S):
-    """S @ (face cross products), coordinate by coordinate (gathers of 1-D arrays are fast)."""
-    x, y, z = (np.ascontiguousarray(P[:, c]) for c in range(3))
-    i, j, k = Fc
-    ax, ay, az = x[j] - x[i], y[j] - y[i], z[j] - z[i]
-    bx, by, bz = x[k] - x[i], y[k] - y[i], z[k] - z[i]
-    Nf = np.empty((len(i), 3), dtype=P.dtype)
-    Nf[:, 0] = ay * bz - az * by
-    Nf[:, 1] = az * bx - ax * bz
-    Nf[:, 2] = ax * by - ay * bx
-    return S @ Nf
-
-
-def normalise_rows(N):
-    length = np.sqrt(np.einsum("ij,ij->i", N, N))
-    zero = length == 0
-    length[zero] = 1.0
-    N /= length[:, None]
-    if zero.any():
-        N[zero] = (0.0, 0.0, 1.0)
-    return N
-
-
-def vertex_normals_fast(V, F, S=None):
-    """Unit vertex normals: the area-weighted sum of the incident face normals.
-
-    Face normals are ``(v1 - v0) x (v2 - v0)`` (twice the area times the unit
-    normal, outward for counter-clockwise faces); their sum at each vertex is
-    one sparse product ``S @ N_f`` with the corner matrix ``S`` (pass it to
-    reuse it). Vertices in no face get the normal (0, 0, 1).
-
-    Returns
-    -------
-    (n, 3) float64
+    A vertex in no face of non-zero area has no normal (a zero row); a picture
+    must still shade it, and the shader's ``normalize`` of a zero vector is
+    undefined, so the view gives it the normal (0, 0, 1), whose light is as
+    good as any. ``F`` must not hold faces that repeat a vertex (they would have added
+    nothing).
     """
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F)
-    if S is None:
-        S = corner_matrix(F, V.shape[0])
-    Fc = [np.ascontiguousarray(F[:, c]) for c in range(3)]
-    return normalise_rows(face_normal_sums(V, Fc, S))
-
-
-# ----------------------------------------------------------------------------
-# camera and the still picture
-# ----------------------------------------------------------------------------
+    N = vertex_normals(V, F)
+    N[~N.any(axis=1)] = (0.0, 0.0, 1.0)
+    return N
 
 
 # ----------------------------------------------------------------------------
@@ -115,9 +70,8 @@ def vertex_normals_fast(V, F, S=None):
 
 def bounding_frame(V):
     """Bounding-box centre and half diagonal of V."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    centre = 0.5 * (lo + hi)
-    radius = 0.5 * float(np.linalg.norm(hi - lo))
+    centre = 0.5 * (V.min(axis=0) + V.max(axis=0))
+    radius = 0.5 * bounding_box_diagonal(V)
     return centre, (radius if radius > 0 else 1.0)
 
 
@@ -182,7 +136,7 @@ def render_still(
     sx = width / 2 + f * (P @ right) / depth
     sy = height / 2 - f * (P @ up) / depth
     if normals is None:
-        normals = vertex_normals_fast(V, F)
+        normals = view_normals(V, F)
     to_eye = eye - P
     to_eye /= np.linalg.norm(to_eye, axis=1, keepdims=True)
     d = np.abs(np.einsum("ij,ij->i", normals, to_eye))

@@ -36,7 +36,7 @@ values against closed forms derived independently.
 Functions: :func:`plane`, :func:`saddle`, :func:`sphere` (icosphere),
 :func:`uv_sphere`, :func:`ellipsoid` (mapped icosphere), :func:`uv_ellipsoid`,
 :func:`torus`, and :func:`attach_truth` for vertices read from a file (for
-instance ``meshes/ellipsoid.obj``).
+instance ``geomlib/meshes/ellipsoid.obj``).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import face_cross
+from ..mesh.geometry import face_cross, zero_area_faces
 from ..mesh.validate import check_choice
 
 __all__ = [
@@ -233,13 +233,10 @@ def _check_faces(V, F, D, what):
     three vertices; this happens only when the jitter folds the tessellation
     over, and is reported rather than repaired.
     """
-    FN = face_cross(V, F)
-    A2 = np.linalg.norm(FN, axis=1)
-    scale = np.mean(np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1)) ** 2
-    bad = np.flatnonzero(A2 <= 1e-12 * scale)
+    bad = zero_area_faces(V, F)
     if bad.size:
         raise MeshError(f"{what}: zero-area faces {format_indices(bad)}")
-    s = np.einsum("ij,ij->i", FN, D[F].sum(axis=1))
+    s = np.einsum("ij,ij->i", face_cross(V, F), D[F].sum(axis=1))
     bad = np.flatnonzero(s <= 0)
     if bad.size:
         raise MeshError(f"{what}: inverted faces {format_indices(bad)} (jitter too large for this resolution)")
@@ -871,7 +868,7 @@ def attach_truth(name, V, F, **params):
     Convention as :class:`AnalyticMesh` (outward / upward ``N``, H > 0 on a
     sphere). Use it for meshes read from a file, e.g.
     ``attach_truth("ellipsoid", V, F, a=1.0, b=0.7, c=0.5)`` for
-    ``meshes/ellipsoid.obj``. The truth is evaluated at the parameters of the
+    ``geomlib/meshes/ellipsoid.obj``. The truth is evaluated at the parameters of the
     nearest exact point: the vertices are projected to the surface for the
     evaluation (a file stores about 9 significant digits), while ``V`` is
     returned as given.

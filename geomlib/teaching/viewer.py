@@ -50,8 +50,8 @@ Updates
 ``view.update(V=..., values=...)`` overwrites the buffers in place: positions,
 normals and colours live in one interleaved float32 buffer, so an update is a
 single widget message and the browser never shows a half-updated frame.
-Normals are area-weighted face normals summed at the vertices by one sparse
-matrix product (prepared once per view). The colour bar's text is a second,
+Normals are :func:`geomlib.mesh.geometry.vertex_normals` (through
+:func:`.stills.view_normals`, which gives a vertex without a normal (0, 0, 1)). The colour bar's text is a second,
 small message and is only sent when the printed range changes (pass fixed
 ``vmin``/``vmax`` for sliders to avoid it).
 
@@ -107,6 +107,9 @@ import weakref
 import numpy as np
 
 from ..mesh.errors import MeshError, format_indices
+from ..mesh.geometry import enclosed_volume
+from ..mesh.topology import Topology, edges
+from ..mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
 from .colours import (
     NAN_COLOR,
     PLAIN_COLOR,
@@ -127,13 +130,11 @@ from .stills import (
     bounding_frame,
     camera_basis,
     camera_distance,
-    corner_matrix,
-    face_normal_sums,
     in_a_row,
-    normalise_rows,
     png_base64,
     render_still,
     still_with_colorbar,
+    view_normals,
 )
 
 __all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "stills_only"]
@@ -182,38 +183,13 @@ void main() {
 # ----------------------------------------------------------------------------
 
 
-def _check_vertices(V, n=None, name="V"):
-    try:
-        V = np.asarray(V, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise MeshError(f"{name} must be an (n, 3) array of numbers: {exc}") from None
-    if V.ndim != 2 or V.shape[1] != 3:
-        raise MeshError(f"{name} must have shape (n, 3); got {V.shape}")
-    if n is not None and V.shape[0] != n:
+def _check_count(V, n):
+    if len(V) != n:
         raise MeshError(
-            f"{name} has {V.shape[0]} vertices; the view was built with {n} "
+            f"V has {len(V)} vertices; the view was built with {n} "
             "(the vertex count cannot change in update; make a new MeshView)"
         )
-    bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-    if bad.size:
-        raise MeshError(f"{name} has non-finite coordinates at vertices {format_indices(bad)}")
     return V
-
-
-def _check_faces(F, n):
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3:
-        raise MeshError(f"F must have shape (m, 3) (triangles); got {F.shape}")
-    if F.shape[0] == 0:
-        raise MeshError("F has no faces; a view needs at least one triangle")
-    if not np.issubdtype(F.dtype, np.integer):
-        if not np.issubdtype(F.dtype, np.floating) or not np.all(np.mod(F, 1) == 0):
-            raise MeshError(f"F must hold integer vertex indices; got dtype {F.dtype}")
-    F = F.astype(np.int64)
-    bad = np.flatnonzero(((F < 0) | (F >= n)).any(axis=1))
-    if bad.size:
-        raise MeshError(f"F refers to vertices outside 0..{n - 1} in faces {format_indices(bad)}")
-    return F
 
 
 def _check_values(values, n):
@@ -237,20 +213,12 @@ def _check_values(values, n):
 
 
 def _closed_outward(V, F):
-    """True when every directed edge (i, j) has its reverse (j, i): a closed,
-    consistently oriented mesh, and its enclosed volume is positive (faces
-    counter-clockwise from outside). Then back faces can never be seen from
-    outside and the renderer may skip them."""
-    n = np.int64(V.shape[0])
-    i, j = F.ravel(), F[:, [1, 2, 0]].ravel()
-    key = np.sort(i * n + j)
-    if key.size > 1 and (key[1:] == key[:-1]).any():
-        return False  # an edge used twice in the same direction
-    reverse = np.sort(j * n + i)
-    if not np.array_equal(key, reverse):
-        return False  # a boundary, or orientation flips somewhere
-    p0, p1, p2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    return float(np.einsum("ij,ij->", p0, np.cross(p1, p2))) > 0
+    """True when every edge has two faces traversing it in opposite directions (a closed,
+    consistently oriented mesh) and the enclosed volume is positive (faces counter-clockwise
+    from outside). Then back faces can never be seen from outside and the renderer may skip them."""
+    T = Topology(F, len(V))
+    closed = (T.edge_face_count == 2).all() and len(T.inconsistent_edges()) == 0
+    return bool(closed) and enclosed_volume(V, F) > 0
 
 
 def _look_at_quaternion(direction, up=UP):
@@ -289,7 +257,7 @@ class MeshView:
     V : (n, 3) float64
         Vertex positions.
     F : (m, 3) int64
-        Triangles (0-based vertex indices).
+        Triangles (0-based vertex indices); a face that repeats a vertex draws nothing.
     values : (n,) float64 or None
         Per-vertex scalar to colour by; None gives plain shading and no colour bar.
     cmap : str or None
@@ -355,12 +323,15 @@ class MeshView:
         import ipywidgets as widgets
         import pythreejs as three
 
-        V = _check_vertices(V)
+        V = as_vertices(V)
         self._n = V.shape[0]
-        self._F = _check_faces(F, self._n)
-        # prepared once: corner columns and the float32 corner matrix for the normals
-        self._Fc = [np.ascontiguousarray(self._F[:, c]) for c in range(3)]
-        self._S32 = corner_matrix(self._F, self._n).astype(np.float32)
+        # a face that repeats a vertex is drawn as nothing, not refused: a view shows any mesh
+        # that can be drawn; the normals, edges and volume come from the real triangles
+        self._F = as_faces(F, self._n, allow_repeated=True)
+        repeated = repeated_vertex_faces(self._F)
+        self._triangles = np.delete(self._F, repeated, axis=0) if len(repeated) else self._F
+        if len(self._triangles) == 0:
+            raise MeshError("every face of F repeats a vertex: there is no triangle to draw")
         self._V = V
         self._values = None if values is None else _check_values(values, self._n)
         self.symmetric = bool(symmetric)
@@ -369,12 +340,10 @@ class MeshView:
         self._fixed = (vmin, vmax)
         self.width, self.height = int(width), int(height)
         self.title, self.label = title, label
-        if up not in VIEWS:
-            raise MeshError(f"up must be one of 'x', 'y', 'z' (the axis drawn upwards); got {up!r}")
-        self.up = up
+        self.up = check_choice("up", up, tuple(VIEWS))
         self._up, self._direction = VIEWS[up]
         self.zero_tol = float(zero_tol)
-        self._centre, self._radius = bounding_frame(V if frame is None else _check_vertices(frame, name="frame"))
+        self._centre, self._radius = bounding_frame(V if frame is None else as_vertices(frame, where="frame"))
         self._scale = 1.0  # drawn this many times larger (side_by_side enlarges specks)
         self._distance = camera_distance(self._radius, self.width, self.height)
 
@@ -390,7 +359,7 @@ class MeshView:
         # closed outward meshes: back faces are hidden anyway and skipping them
         # halves the software rasteriser's work; open or inconsistently oriented
         # meshes show both sides
-        self.closed = _closed_outward(V, self._F)
+        self.closed = _closed_outward(V, self._triangles)
         material = three.ShaderMaterial(
             vertexShader=_VERTEX_SHADER,
             fragmentShader=_FRAGMENT_SHADER,
@@ -405,8 +374,7 @@ class MeshView:
         self.mesh = three.Mesh(geometry=self.geometry, material=material)
         children = [self.mesh]
         if wireframe:
-            E = np.sort(self._F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-            E = np.unique(E, axis=0)
+            E = edges(self._triangles)
             lines = three.BufferGeometry(
                 index=three.BufferAttribute(array=E.astype(np.uint32).ravel(), normalized=False),
                 attributes={"position": position},
@@ -515,10 +483,9 @@ class MeshView:
         buf = np.empty((self._n, 9), dtype=np.float32)
         if V:
             # positions relative to the first bounding-box centre (float32 keeps
-            # its precision near the origin); normals in float32 from those
-            P = (self._V - self._centre).astype(np.float32)
-            buf[:, 0:3] = P
-            buf[:, 3:6] = normalise_rows(face_normal_sums(P, self._Fc, self._S32))
+            # its precision near the origin)
+            buf[:, 0:3] = self._V - self._centre
+            buf[:, 3:6] = view_normals(self._V, self._triangles)
         else:
             buf[:, 0:6] = old[:, 0:6]
         if colors:
@@ -570,7 +537,7 @@ class MeshView:
         """
         new_V = V is not None
         if new_V:
-            self._V = _check_vertices(V, self._n)
+            self._V = _check_count(as_vertices(V), self._n)
         new_colors = False
         if values is not None:
             self._values = _check_values(values, self._n)
