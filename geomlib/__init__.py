@@ -62,6 +62,9 @@ _EXPORTS = {
     "gaussian_curvature": "lessons.curvature",
     "principal_curvatures": "lessons.curvature",
     "vertex_normals": "mesh.geometry",
+    "mean_edge_length": "mesh.geometry",
+    "surface_area": "mesh.geometry",
+    "enclosed_volume": "mesh.geometry",
     # spectral
     "eigenbasis": "lessons.spectral",
     "spectral_reconstruction": "lessons.spectral",
@@ -74,6 +77,8 @@ _EXPORTS = {
     "implicit_smoothing": "lessons.smoothing",
     "explicit_step_limit": "lessons.smoothing",
     "highest_frequency_mode": "lessons.smoothing",
+    "mode_factor": "lessons.filters",
+    "plot_mode_factors": "lessons.filters",
     "fixed_point": "lessons.smoothing",
     "ExplicitSmoother": "lessons.smoothing",
     "ImplicitSmoother": "lessons.smoothing",
@@ -93,6 +98,9 @@ _EXPORTS = {
     "MeshComparison": "lessons.metrics",
     "point_surface_distance": "lessons.metrics",
     "smoothing_sweep": "teaching.sweep",
+    # progress over the notebooks' loops over meshes
+    "loop": "numerics.progress",
+    "LARGE_MESH": "numerics.progress",
 }
 
 # modules reachable by their short public names (geomlib.symbolic, geomlib.check, ...)

@@ -1,4 +1,34 @@
 """Teaching aids: 3D views and stills, exercise checks, notebook helpers, experiment drivers.
 
 May import every other layer; no other layer imports it.
+
+The names a lesson notebook uses are importable from here, so that a notebook's
+teaching aids come in one line (``from geomlib.teaching import claim, live, MeshView``).
+They are imported on first use: the 3D viewer is not loaded by a notebook that only checks.
 """
+
+from importlib import import_module
+
+# public name -> module that defines it (imported on first use)
+_EXPORTS = {
+    **dict.fromkeys(["use"], "check"),
+    **dict.fromkeys(["live", "mesh_warnings"], "controls"),
+    **dict.fromkeys(["claim", "explain", "note", "prepare", "show_source"], "notebook"),
+    **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "steps"),
+    **dict.fromkeys(["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "smoothing_sweep"], "sweep"),
+    **dict.fromkeys(["MeshView", "side_by_side"], "viewer"),
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(f".{_EXPORTS[name]}", __name__), name)
+    globals()[name] = value  # later look-ups skip this hook
+    return value
+
+
+def __dir__():
+    return __all__
