@@ -128,7 +128,7 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
     Q = np.empty((n, min(n, k + 8 * int(np.sqrt(k)) + 4 * b)), order="F")
     T = np.zeros((Q.shape[1] + b, Q.shape[1] + b))
     Qj = la.qr(rng.uniform(-1.0, 1.0, (n, b)), mode="economic")[0]
-    j, check = 0, k + 6 * np.sqrt(k) + 2 * b
+    j, check, last = 0, k + 6 * np.sqrt(k) + 2 * b, None
     while True:
         if j + b > Q.shape[1]:  # grow the basis by half
             grown = min(n, Q.shape[1] + Q.shape[1] // 2 + b)
@@ -155,9 +155,13 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
         if j >= check or full:
             band = np.array([np.pad(np.diagonal(T[:j, :j], -d), (0, d)) for d in range(b + 1)])
             theta, U = la.eig_banded(band, lower=True, select="i", select_range=(j - k, j - 1), check_finite=False)
-            if full or np.all(np.linalg.norm(B @ U[j - b :], axis=0) <= tol * theta):
+            worst = np.max(np.linalg.norm(B @ U[j - b :], axis=0) / theta)
+            if full or worst <= tol:
                 return Q[:, :j] @ U
-            check = j + max(b, int(np.sqrt(k)))
+            # the residual falls about geometrically with j: check again halfway to where it reaches tol
+            rate = np.log(last[1] / worst) / (j - last[0]) if last and last[1] > worst else 0.0
+            ahead = 0.5 * np.log(worst / tol) / rate if rate > 0 else 2 * np.sqrt(k)
+            last, check = (j, worst), j + max(b, min(ahead, k))
 
 
 def largest_eigenpair(S, tol=1e-8):
