@@ -6,6 +6,7 @@
     python3 workbook.py test       # every test: unit, notebooks (nbval), browser
     python3 workbook.py assignment # the assignment version in build/assignment/
     python3 workbook.py site       # the workbook as a static website in build/site/
+    python3 workbook.py run 05 STEP=1e-4 ...   # one notebook with those parameters, into build/runs/
     python3 workbook.py setup      # only create or update .venv
 
 Each creates the virtual environment ``.venv`` beside this file when it is
@@ -13,7 +14,8 @@ missing, and (re)installs the pinned package set (``constraints.txt``) when
 ``pyproject.toml`` or ``constraints.txt`` changed since the last install.
 Needs only Python 3.11 or newer with its standard ``venv`` module.
 Extra arguments after ``test`` go to pytest, after ``lab`` to JupyterLab,
-after ``notebook`` to Jupyter Notebook.
+after ``notebook`` to Jupyter Notebook; ``run`` takes a notebook and NAME=VALUE
+pairs (tools/run_notebook.py says more).
 """
 
 import hashlib
@@ -105,7 +107,7 @@ def test_workers(args):
 
 
 def main(argv):
-    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment", "site"):
+    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment", "site", "run"):
         print(__doc__)
         return 2
     command, rest = argv[0], argv[1:]
@@ -118,6 +120,9 @@ def main(argv):
         return subprocess.call([str(PY), str(ROOT / "tools" / "build_assignment.py"), *rest], cwd=ROOT, env=env)
     if command == "site":
         return subprocess.call([str(PY), str(ROOT / "tools" / "build_site.py"), *rest], cwd=ROOT, env=env)
+    if command == "run":
+        # in the caller's folder: relative paths in the values are relative to it
+        return subprocess.call([str(PY), str(ROOT / "tools" / "run_notebook.py"), *rest], env=env)
     if command in ("lab", "notebook"):
         cmd = front_end_command(command, rest, root=hasattr(os, "geteuid") and os.geteuid() == 0)
         print("+", " ".join(cmd), flush=True)

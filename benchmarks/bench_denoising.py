@@ -3,7 +3,7 @@
 
     python benchmarks/bench_denoising.py [--repeats 3]
 
-Prints, on the meshes the notebook uses (meshes/sphere.obj and meshes/cad_part.obj):
+Prints, on the meshes the notebook uses (geomlib/meshes/sphere.obj and geomlib/meshes/cad_part.obj):
 
 * the full sweep of notebook 07 (5 noise levels x 4 schemes x 4 steps x 9
   iteration counts per mesh, one run per setting through the smoothing

@@ -81,7 +81,7 @@ def baseline(V, F, step, iterations):
     return P
 
 
-def ours(V, F, step, iterations, solver="lu"):
+def ours(V, F, step, iterations, solver="cholesky"):
     from geomlib import implicit_smoothing
 
     return implicit_smoothing(V, F, step, iterations, solver=solver, progress=False)
@@ -204,8 +204,8 @@ def bench_limit():
     meshes = [next(slider_meshes()), ("icosphere",) + noisy_icosphere(7)[:2]]
     for name, V, F in meshes:
         for weights in ("cotan", "uniform"):
-            t_first, limit = timed(explicit_step_limit, V, F, weights, boundary="free")
-            t_cached, _ = timed(explicit_step_limit, V, F, weights, boundary="free")
+            t_first, limit = timed(explicit_step_limit, V, F, weights, boundary_condition="free")
+            t_cached, _ = timed(explicit_step_limit, V, F, weights, boundary_condition="free")
             M, C = laplacian(V, F, weights=weights)
             d = sp.diags(1.0 / np.sqrt(M.diagonal()))
             S = (d @ (-C) @ d).tocsr()

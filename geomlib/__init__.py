@@ -57,7 +57,6 @@ _EXPORTS = {
     "vertex_face_adjacency": "mesh.topology",
     # Laplacians and curvature
     "laplacian": "lessons.laplace",
-    "cotangent_weights": "lessons.laplace",
     "vertex_areas": "lessons.laplace",
     "mean_curvature": "lessons.curvature",
     "gaussian_curvature": "lessons.curvature",
@@ -147,7 +146,7 @@ def data_path(name=""):
     path = folder / name
     if name and not path.exists():
         have = sorted(p.name for p in folder.glob("*") if p.suffix in (".obj", ".off", ".ply", ".stl"))
-        raise MeshError(f"no shipped mesh named {name!r} in meshes/; available: {', '.join(have) or 'none'}")
+        raise MeshError(f"no shipped mesh named {name!r} in geomlib/meshes/; available: {', '.join(have) or 'none'}")
     return path
 
 

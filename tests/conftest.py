@@ -9,4 +9,13 @@ inputs (tests/notebook_runner.py) set it to 0 for their own kernels.
 
 import os
 
+import pytest
+from awkward_meshes import make_all
+
 os.environ["GEOMLIB_STRICT_CLAIMS"] = "1"
+
+
+@pytest.fixture(scope="module")
+def awkward(tmp_path_factory):
+    """The awkward meshes of tests/awkward_meshes.py, written once per test module: name -> path (str)."""
+    return {name: str(path) for name, path in make_all(tmp_path_factory.mktemp("awkward")).items()}

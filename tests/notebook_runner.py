@@ -48,6 +48,16 @@ class Run:
     def assert_ran(self):
         assert not self.error, f"{self.name} with {self.parameters} raised:\n{self.error}"
 
+    def notes_text(self):
+        """The notes, one a line."""
+        return "\n".join(self.notes)
+
+    def assert_said(self, *phrases):
+        """Every phrase stands in some note (the failure lists the notes)."""
+        text = self.notes_text()
+        for phrase in phrases:
+            assert phrase in text, f"no note says {phrase!r}; the notes were:\n{text}"
+
     def outputs_text(self):
         """All text/plain and text/markdown of the outputs, joined."""
         parts = []
@@ -101,3 +111,11 @@ def run_notebook(name, timeout=600, **parameters):
             os.environ.update(saved)
         seconds = time.perf_counter() - start
     return Run(name, parameters, seconds, nb, error, _notes(nb))
+
+
+def ran(name, **parameters):
+    """run_notebook, asserting that it ran; its time and note count are printed (``pytest -s``)."""
+    run = run_notebook(name, **parameters)
+    run.assert_ran()
+    print(f"{name} {sorted(parameters)}: {run.seconds:.1f} s, {len(run.notes)} notes")
+    return run

@@ -7,6 +7,7 @@ angles from the edge vectors), with one mistake; the check must name that mistak
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from diagnoses import assert_diagnosed
 
 from geomlib import check
 from geomlib.lessons.laplace import barycentric_areas, laplacian, mixed_areas
@@ -73,17 +74,18 @@ def test_learner_loop_laplacian_passes():
 
 @pytest.mark.parametrize("mistake, phrase", WRONG_LAPLACIANS, ids=[p for _, p in WRONG_LAPLACIANS])
 def test_wrong_laplacian_is_diagnosed(mistake, phrase):
-    result = check.cotangent_laplacian(lambda V, F: learner_laplacian(V, F, **mistake))
-    assert not result.passed
-    assert phrase in result.message, result.message
-    assert "Reread section 1 · Cotangent weights, derived" in result.message
+    assert_diagnosed(
+        check.cotangent_laplacian(lambda V, F: learner_laplacian(V, F, **mistake)),
+        phrase,
+        "Reread section 1 · Cotangent weights, derived",
+    )
 
 
 def test_laplacian_shapes_are_diagnosed():
-    result = check.cotangent_laplacian(lambda V, F: laplacian(V, F)[1])
-    assert not result.passed and "not the pair (M, C)" in result.message
-    result = check.cotangent_laplacian(lambda V, F: (laplacian(V, F)[0].diagonal(), laplacian(V, F)[1]))
-    assert not result.passed and "M is a vector" in result.message
+    assert_diagnosed(check.cotangent_laplacian(lambda V, F: laplacian(V, F)[1]), "not the pair (M, C)")
+    assert_diagnosed(
+        check.cotangent_laplacian(lambda V, F: (laplacian(V, F)[0].diagonal(), laplacian(V, F)[1])), "M is a vector"
+    )
 
 
 def learner_areas(V, F, divide=3.0, double=False, per_face=False):
@@ -111,15 +113,15 @@ def test_reference_areas_pass():
 
 @pytest.mark.parametrize("mistake, phrase", WRONG_AREAS, ids=[p for _, p in WRONG_AREAS])
 def test_wrong_areas_are_diagnosed(mistake, phrase):
-    result = check.vertex_areas(lambda V, F: learner_areas(V, F, **mistake))
-    assert not result.passed
-    assert phrase in result.message, result.message
-    assert "Which area? Barycentric and mixed Voronoi" in result.message
+    assert_diagnosed(
+        check.vertex_areas(lambda V, F: learner_areas(V, F, **mistake)),
+        phrase,
+        "Which area? Barycentric and mixed Voronoi",
+    )
 
 
 def test_mixed_instead_of_barycentric_is_diagnosed():
-    result = check.vertex_areas(mixed_areas)
-    assert not result.passed and "mixed (Voronoi) areas, not the barycentric" in result.message
+    assert_diagnosed(check.vertex_areas(mixed_areas), "mixed (Voronoi) areas, not the barycentric")
 
 
 def learner_mixed(V, F, rule="meyer"):
@@ -161,9 +163,7 @@ def test_reference_mixed_passes():
 
 @pytest.mark.parametrize("rule, phrase", WRONG_MIXED, ids=[p for _, p in WRONG_MIXED])
 def test_wrong_mixed_is_diagnosed(rule, phrase):
-    result = check.mixed_areas(lambda V, F: learner_mixed(V, F, rule))
-    assert not result.passed
-    assert phrase in result.message, result.message
+    assert_diagnosed(check.mixed_areas(lambda V, F: learner_mixed(V, F, rule)), phrase)
 
 
 @pytest.mark.parametrize("name", ["cotangent_laplacian", "vertex_areas", "mixed_areas"])
@@ -171,8 +171,7 @@ def test_stub_is_not_written_yet(name):
     def stub(V, F):
         raise NotImplementedError("Your turn")
 
-    result = getattr(check, name)(stub)
-    assert not result.passed and "not written yet" in result.message
+    assert_diagnosed(getattr(check, name)(stub), "not written yet")
 
 
 def test_strict_mode_raises_for_a_written_wrong_function(monkeypatch):

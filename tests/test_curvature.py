@@ -4,13 +4,12 @@ import warnings
 
 import numpy as np
 import pytest
-from meshdata import COURSE, COURSE_MESHES, SHIPPED, needs_course
+from meshdata import COURSE, COURSE_MESHES, SHIPPED, load_quietly, needs_course
 
 from geomlib import (
     MeshError,
     MeshWarning,
     gaussian_curvature,
-    load_mesh,
     mean_curvature,
     principal_curvatures,
     surfaces,
@@ -321,17 +320,13 @@ def test_libigl_gaussian_curvature_generated(name):
 
 @pytest.mark.parametrize("name", sorted(p.name for p in SHIPPED.glob("*.obj")))
 def test_libigl_gaussian_curvature_shipped(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        _against_libigl(*load_mesh(SHIPPED / name))
+    _against_libigl(*load_quietly(SHIPPED / name))
 
 
 @needs_course
 @pytest.mark.parametrize("name", COURSE_MESHES)
 def test_libigl_gaussian_curvature_course(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        V, F = load_mesh(COURSE / name)
+    V, F = load_quietly(COURSE / name)
     _against_libigl(V, F)
     # Gauss-Bonnet with the turning angle on every course mesh, open or closed
     total = gaussian_curvature(V, F, boundary="turning", integrated=True)
@@ -381,3 +376,21 @@ def test_principal_curvatures_of_a_cylinder_point():
     # cylinder of radius 2: H = 1/4, K = 0, so kappa_1 = 1/2 and kappa_2 = 0
     k1, k2 = principal_curvatures(np.array([0.25]), np.array([0.0]))
     assert k1.tolist() == [0.5] and k2.tolist() == [0.0]
+
+
+def test_zero_below_rounding_zeroes_rounding_noise_of_a_flat_grid_and_keeps_curvature():
+    from geomlib.mesh.geometry import mean_edge_length, zero_below_rounding
+
+    flat = surfaces.plane(n=9, size=0.3, jitter=0.3, seed=1)
+    ell = mean_edge_length(flat.V, flat.F)
+    K = gaussian_curvature(flat.V, flat.F)
+    H = mean_curvature(flat.V, flat.F, weights="uniform", signed=True, boundary="nan")
+    K0, H0 = zero_below_rounding(K, 1 / ell**2), zero_below_rounding(H, ell)
+    inside = np.isfinite(K)
+    assert inside.any() and np.isnan(K0[~inside]).all()  # NaN is kept
+    assert (K0[inside] == 0).all() and not np.signbit(K0[inside]).any()  # +0.0: no "K < 0", no "-0"
+    assert (H0[np.isfinite(H0)] == 0).all() and not np.signbit(H0[np.isfinite(H0)]).any()
+    ball = surfaces.sphere(1e-3, subdivisions=2)  # tiny but curved: nothing is rounding
+    Kb = gaussian_curvature(ball.V, ball.F)
+    assert np.array_equal(zero_below_rounding(Kb, 1 / mean_edge_length(ball.V, ball.F) ** 2), Kb)
+    assert zero_below_rounding([-5e-10, 2e-9], 1.0).tolist() == [0.0, 2e-9]

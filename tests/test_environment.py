@@ -1,7 +1,8 @@
 """The set-up files ask for what they should.
 
-* pyproject.toml: the package requires the libraries geomlib and the notebooks
-  import, as ranges; the front-end (JupyterLab, Notebook, the kernel and the
+* pyproject.toml: the package requires exactly the third-party modules geomlib
+  imports (an AST scan of its files; the notebooks import nothing more), as
+  ranges; the front-end (JupyterLab, Notebook, the kernel and the
   widget packages) is pinned only in the ``lab`` extra, so installing geomlib
   into a working Jupyter leaves that Jupyter alone.
 * constraints.txt pins every declared package exactly, inside its range; the
@@ -11,9 +12,14 @@
 * The Python version tested (environment.yml, README) is one the package declares.
 """
 
+import ast
+import importlib.metadata
 import importlib.util
+import json
 import re
+import sys
 import tomllib
+import warnings
 from pathlib import Path
 
 import yaml
@@ -68,6 +74,63 @@ def _environment():
         else:
             conda.append(dep)
     return env, conda, pip
+
+
+def _imported_modules(sources):
+    """Top-level names of the absolute imports in the Python sources (texts), the standard library left out."""
+    names = set()
+    for source in sources:
+        with warnings.catch_warnings():  # escape sequences in the notebooks' strings are theirs to mind
+            warnings.simplefilter("ignore")
+            tree = ast.parse(source)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                names.update(alias.name.partition(".")[0] for alias in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                names.add(node.module.partition(".")[0])
+    return {name for name in names if name not in sys.stdlib_module_names and name != "geomlib"}
+
+
+def _distributions(modules):
+    """{module: distribution name} for importable top-level modules, as installed here."""
+    owners = importlib.metadata.packages_distributions()
+    missing = sorted(m for m in modules if m not in owners)
+    assert not missing, f"imported but installed by no distribution here: {missing}"
+    ambiguous = {m: owners[m] for m in modules if len(set(map(canonicalize_name, owners[m]))) != 1}
+    assert not ambiguous, f"modules provided by several distributions: {ambiguous}"
+    return {m: canonicalize_name(owners[m][0]) for m in modules}
+
+
+def _notebook_sources():
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        for cell in json.loads(path.read_text())["cells"]:
+            if cell["cell_type"] == "code":
+                # IPython's magics and shell escapes are not Python
+                lines = "".join(cell["source"]).splitlines()
+                yield "\n".join(line for line in lines if not line.lstrip().startswith(("%", "!")))
+
+
+def test_package_requires_exactly_what_geomlib_imports():
+    imported = _distributions(_imported_modules(p.read_text() for p in (ROOT / "geomlib").rglob("*.py")))
+    required = set(_requirements(_project()["dependencies"]))
+    unused = sorted(required - set(imported.values()))
+    assert not unused, f"[project] dependencies that geomlib never imports (move them to an extra): {unused}"
+    undeclared = sorted(f"{d} (import {m})" for m, d in imported.items() if d not in required)
+    assert not undeclared, f"geomlib imports these, but [project] dependencies lacks them: {undeclared}"
+
+
+def test_notebooks_import_nothing_the_package_does_not_require():
+    """A course installs the package and opens the notebooks: they must need nothing more."""
+    imported = _distributions(_imported_modules(_notebook_sources()))
+    required = set(_requirements(_project()["dependencies"]))
+    extra = sorted(f"{d} (import {m})" for m, d in imported.items() if d not in required)
+    assert not extra, f"the notebooks import packages the installed geomlib does not bring: {extra}"
+
+
+def test_import_scan_sees_imports_inside_functions_and_leaves_the_standard_library_out():
+    source = "import os\nimport numpy.linalg as la\nfrom . import x\ndef f():\n    from PIL import Image\n"
+    assert _imported_modules([source]) == {"numpy", "PIL"}
+    assert _distributions({"numpy", "PIL"}) == {"numpy": "numpy", "PIL": "pillow"}
 
 
 def _workbook():

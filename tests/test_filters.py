@@ -8,6 +8,7 @@ matplotlib.use("Agg")
 import numpy as np
 import pytest
 
+from geomlib import MeshError
 from geomlib.lessons.filters import SCHEMES, mode_factor, plot_mode_factors
 
 
@@ -34,9 +35,9 @@ def test_taubin_keeps_low_frequencies_and_needs_its_signs():
     lam = np.array([0.0, 1e-3])
     f = mode_factor(lam, 0.5, "taubin", tau_inflate=-0.53)
     assert f[0] == 1.0 and f[1] > 1.0 - 1e-4  # the pass band is (nearly) untouched
-    with pytest.raises(ValueError, match="tau_inflate < 0"):
+    with pytest.raises(MeshError, match="tau_inflate < 0"):
         mode_factor(lam, 0.5, "taubin", tau_inflate=0.5)
-    with pytest.raises(ValueError, match="scheme must be one of"):
+    with pytest.raises(MeshError, match="scheme must be one of"):
         mode_factor(lam, 0.5, "heun")
 
 
@@ -47,3 +48,15 @@ def test_plot_draws_every_scheme_and_the_eigenvalue_band():
         assert scheme in labels
     assert any(label.startswith("Taubin") for label in labels)
     assert len(ax.patches) == 1 and ax.patches[0].get_label() == "this mesh's eigenvalues"
+
+
+def test_explicit_damps_more_than_diffusion_in_magnitude_only_below_x_1_2785():
+    # the module docstring: the signed chain holds for every x > 0, the magnitudes cross at x = 1.2785
+    x = np.linspace(1e-3, 1.999, 4000)
+    explicit, diffusion, implicit = (mode_factor(x, 1.0, s) for s in ("explicit", "diffusion", "implicit"))
+    assert (implicit > diffusion).all() and (diffusion > explicit).all()
+    crossing = x[np.argmax(np.abs(explicit) > diffusion)]
+    assert abs(crossing - 1.2785) < 1e-3
+    assert (np.abs(explicit[x < 1.278]) < diffusion[x < 1.278]).all()
+    assert np.isclose(abs(mode_factor(1.8, 1.0, "explicit")), 0.8)
+    assert np.isclose(mode_factor(1.8, 1.0, "diffusion"), 0.1653, atol=1e-4)

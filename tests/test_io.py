@@ -4,7 +4,12 @@ Every bad-input case checks the message: the problem, and where (path, line,
 vertex or face indices).
 """
 
+import logging
 import re
+import struct
+import subprocess
+import sys
+import threading
 import warnings
 from pathlib import Path
 
@@ -445,6 +450,85 @@ def test_ply_and_stl_garbage(tmp_path):
     )
     expect(write(tmp_path, "h.ply", b"ply\nformat ascii 1.0\nelement vertex x\n"), r": cannot read as PLY: ")
     expect(write(tmp_path, "g.stl", b"solid x\nfacet what\n"), r": cannot read as STL: ")
+
+
+# ---------------------------------------------------------------- library logging off the reader's screen
+
+# an ASCII STL whose facet normals do not parse (trimesh logs a traceback and goes on)
+STL_BAD_NORMALS = (
+    "solid x\nfacet normal a b c\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex {}\nendloop\nendfacet\nendsolid x\n"
+)
+# a binary STL whose header announces 5 facets and holds one
+STL_TRUNCATED = (
+    b"binary".ljust(80) + struct.pack("<I", 5) + struct.pack("<12fH", *[0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0], 0)
+)
+
+
+def _heard(caplog):
+    """Log records a reader could see: trimesh's at any level, and any library's warning or worse.
+
+    (trimesh's text decoding asks charset_normalizer, which logs at DEBUG level: shown
+    only to a reader who turned DEBUG logging on.)
+    """
+    return [
+        f"{r.name}: {r.getMessage()}"
+        for r in caplog.records
+        if r.name.split(".")[0] == "trimesh" or r.levelno >= logging.WARNING
+    ]
+
+
+@pytest.mark.parametrize(
+    "name, data, problem",
+    [
+        ("normals.stl", STL_BAD_NORMALS.format("0 nan 0"), r": 1 vertex has NaN or infinite coordinates: vertices 2"),
+        ("short.stl", STL_TRUNCATED, r": cannot read as STL: no mesh found in the file$"),
+    ],
+)
+def test_malformed_stl_shows_the_mesh_error_and_nothing_else(tmp_path, caplog, capfd, name, data, problem):
+    path = write(tmp_path, name, data)
+    caplog.set_level(logging.DEBUG)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(MeshError, match=problem):
+            load_mesh(path)
+    assert _heard(caplog) == []
+    assert caught == []
+    assert capfd.readouterr() == ("", "")
+
+
+def test_stl_with_unreadable_normals_loads_without_a_word(tmp_path, caplog, capfd):
+    """geomlib does not use an STL's normals: trimesh's complaint about them is no news for the reader."""
+    caplog.set_level(logging.DEBUG)
+    V, F = load_quiet(write(tmp_path, "normals.stl", STL_BAD_NORMALS.format("0 1 0")))
+    assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [0, 1, 0]]) and np.array_equal(F, [[0, 1, 2]])
+    assert _heard(caplog) == []
+    assert capfd.readouterr() == ("", "")
+
+
+def test_malformed_stl_prints_nothing_on_a_plain_python_stderr(tmp_path):
+    """Without pytest's log handlers, Python prints unhandled log records on stderr: none may come."""
+    path = write(tmp_path, "normals.stl", STL_BAD_NORMALS.format("0 nan 0"))
+    code = "import sys, geomlib\ntry:\n    geomlib.load_mesh(sys.argv[1])\nexcept geomlib.MeshError as e:\n    print(e)"
+    done = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True, cwd=tmp_path)
+    assert done.stderr == ""
+    assert done.stdout.strip() == f"{path}: 1 vertex has NaN or infinite coordinates: vertices 2 (0-based)"
+
+
+def test_trimesh_logs_as_configured_outside_geomlib_calls(tmp_path, caplog):
+    """Only geomlib's own calls are quiet: after them, and in another thread, trimesh logs as before."""
+    caplog.set_level(logging.WARNING)
+    path = write(tmp_path, "normals.stl", STL_BAD_NORMALS.format("0 1 0"))
+    load_quiet(path)
+    logger = logging.getLogger("trimesh.util")
+    assert logger.filters == []
+    logger.warning("after the load")
+    assert [r.getMessage() for r in caplog.records] == ["after the load"]
+
+    caplog.clear()
+    other = threading.Thread(target=trimesh.load, args=(str(path),), kwargs={"process": False})
+    other.start()
+    other.join()
+    assert [r.getMessage() for r in caplog.records] == ["failed to extract face_normals"]
 
 
 def test_ply_out_of_range_and_nan(tmp_path):

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import trimesh
-from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, needs_course
+from meshdata import COURSE, COURSE_MESHES, SHIPPED, SHIPPED_MESHES, load_quietly, needs_course
 
-from geomlib import MeshError, MeshWarning, cotangent_weights, laplacian, load_mesh, surfaces, vertex_areas
+from geomlib import MeshError, MeshWarning, laplacian, surfaces, vertex_areas
 from geomlib.lessons.laplace import (
     barycentric_areas,
     cotangent_matrix,
@@ -61,7 +61,7 @@ def test_obtuse_triangle_mixed_area():
     A = 0.5 * np.sin(2 * np.pi / 3)
     np.testing.assert_allclose(vertex_areas(V, F, "mixed"), [A / 2, A / 4, A / 4], atol=1e-15)
     np.testing.assert_allclose(vertex_areas(V, F, "barycentric"), [A / 3] * 3, atol=1e-15)
-    C = dense(cotangent_weights(V, F))
+    C = dense(cotangent_matrix(V, F))
     # cot(120) = -1/sqrt(3) on the edge opposite vertex 0; cot(30) = sqrt(3) elsewhere
     assert C[1, 2] == pytest.approx(-0.5 / np.sqrt(3), abs=1e-15)
     assert C[0, 1] == pytest.approx(0.5 * np.sqrt(3), abs=1e-15)
@@ -237,7 +237,7 @@ def test_bad_triangles_give_finite_matrices(weights, area):
 def test_needle_triangle_cotangent_is_exact():
     h = 1e-9
     V = np.array([[-1.0, 0, 0], [1, 0, 0], [0, h, 0]])
-    C = dense(cotangent_weights(V, [[0, 1, 2]]))
+    C = dense(cotangent_matrix(V, [[0, 1, 2]]))
     # angle at the apex is pi - 2 atan(h): cot = (h^2 - 1) / (2 h)
     assert C[0, 1] == pytest.approx(0.5 * (h * h - 1) / (2 * h), rel=1e-9)
     assert C[0, 2] == pytest.approx(0.5 / h, rel=1e-9)
@@ -263,8 +263,8 @@ def test_non_manifold_edge_sums_its_triangles():
     # three triangles on the edge (0, 1)
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, -1, 0], [0.5, 0, 1]])
     F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])
-    C = dense(cotangent_weights(V, F))
-    expected = sum(float(dense(cotangent_weights(V, [f]))[0, 1]) for f in F)
+    C = dense(cotangent_matrix(V, F))
+    expected = sum(float(dense(cotangent_matrix(V, [f]))[0, 1]) for f in F)
     assert C[0, 1] == pytest.approx(expected, rel=1e-14)
     assert np.linalg.eigvalsh(C).max() < 1e-14
 
@@ -295,17 +295,13 @@ def test_libigl_generated(name):
 
 @pytest.mark.parametrize("name", SHIPPED_MESHES)
 def test_libigl_shipped_meshes(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        _against_libigl(*load_mesh(SHIPPED / name))
+    _against_libigl(*load_quietly(SHIPPED / name))
 
 
 @needs_course
 @pytest.mark.parametrize("name", COURSE_MESHES)
 def test_libigl_course_meshes(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)
-        _against_libigl(*load_mesh(COURSE / name))
+    _against_libigl(*load_quietly(COURSE / name))
 
 
 # ---------------------------------------------------------------- the teaching functions one by one
@@ -369,3 +365,18 @@ def test_teaching_functions_against_libigl_one_by_one():
     np.testing.assert_allclose(
         mixed_areas(V, F), igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal(), rtol=1e-12
     )
+
+
+def test_laplacian_measures_the_faces_once(monkeypatch):
+    import geomlib.lessons.laplace as laplace
+
+    calls = []
+    measure = laplace.face_geometry
+    monkeypatch.setattr(laplace, "face_geometry", lambda V, F: calls.append(1) or measure(V, F))
+    V, F = surfaces.sphere(1.0, subdivisions=2).V, surfaces.sphere(1.0, subdivisions=2).F
+    for area in ("barycentric", "mixed"):
+        calls.clear()
+        M, C = laplacian(V, F, area=area)
+        assert len(calls) == 1
+        np.testing.assert_array_equal(C.toarray(), cotangent_matrix(V, F).toarray())
+        np.testing.assert_array_equal(M.diagonal(), vertex_areas(V, F, area))

@@ -1,4 +1,4 @@
-"""Tests of the shipped meshes (meshes/*.obj, meshes/README.md) and their generator."""
+"""Tests of the shipped meshes (geomlib/meshes/*.obj, geomlib/meshes/README.md) and their generator."""
 
 import importlib.util
 import re
@@ -57,7 +57,7 @@ def load(name):
 
 
 def readme_table():
-    """{file: {column: text}} from the table in meshes/README.md."""
+    """{file: {column: text}} from the table in geomlib/meshes/README.md."""
     lines = [ln for ln in (MESHES / "README.md").read_text().splitlines() if ln.startswith("|")]
     head = [c.strip() for c in lines[0].strip("|").split("|")]
     rows = {}
@@ -235,7 +235,7 @@ def test_noisy_cad_part_moves_along_normals():
     V1, F1, _ = load("cad_part_noisy.obj")
     np.testing.assert_array_equal(F0, F1)
     D = V1 - V0
-    N = mm.vertex_normals(V0, F0)
+    N = geomlib.vertex_normals(V0, F0)
     tangential = D - np.einsum("ij,ij->i", D, N)[:, None] * N
     assert np.abs(tangential).max() < 1e-7
     sigma = 0.005 * np.linalg.norm(V0.max(0) - V0.min(0))

@@ -5,8 +5,8 @@ import pytest
 import trimesh
 
 from geomlib import MeshError, add_noise
-from geomlib.lessons.curvature import vertex_normals
 from geomlib.lessons.metrics import bounding_box_diagonal
+from geomlib.mesh.geometry import vertex_normals
 
 
 @pytest.fixture(scope="module")

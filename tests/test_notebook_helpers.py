@@ -1,5 +1,7 @@
 """geomlib.teaching.notebook (show_source, explain, claim, note) and the check vocabulary."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -83,7 +85,7 @@ def _check_double(fn):
     if np.allclose(x, np.arange(3.0)):
         raise Mistake("nothing was doubled", "multiply by 2")
     if not np.allclose(x, 2 * np.arange(3.0)):
-        raise Mistake("the result is not twice the input")
+        raise Mistake("the result is not twice the input", typical=False)
     return ["a vector of three numbers"]
 
 
@@ -136,6 +138,61 @@ def test_use_falls_back_to_the_reference(capsys, monkeypatch):
     assert "has not passed its check yet" in capsys.readouterr().out
     good = lambda x: 2 * x  # noqa: E731
     assert use(good, _check_double, reference) is good
+
+
+def _stub(x):
+    raise NotImplementedError
+
+
+def test_while_nbgrader_grades_a_failed_check_raises_its_diagnosis_and_use_still_falls_back(monkeypatch, capsys):
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    with pytest.raises(CheckFailed, match="^double: not written yet"):
+        _check_double(_stub)
+    with pytest.raises(CheckFailed) as failed:
+        _check_double(lambda x: x)
+    # IPython (and so nbgrader's feedback page) shows this line instead of geomlib's frames
+    assert failed.value._render_traceback_() == [
+        "CheckFailed: double: nothing was doubled. Hint: multiply by 2. Reread section 1."
+    ]
+    assert _check_double(lambda x: 2 * x).passed
+    assert use(_stub, _check_double, np.negative) is np.negative
+    assert "has not passed its check yet" in capsys.readouterr().out
+
+
+def test_partial_credit_for_a_mistake_the_check_names(monkeypatch):
+    monkeypatch.setenv("NBGRADER_EXECUTION", "validate")
+    assert _check_double.partial_credit(lambda x: 2 * x).passed
+    named = _check_double.partial_credit(lambda x: x)  # "nothing was doubled"
+    assert named.passed and named.name == "double, partial credit"
+    for wrong, reason in (
+        (lambda x: 3 * x, "not earned: the check cannot name what is wrong"),  # only the catch-all fits
+        (lambda x: x[:2], "not earned: the check cannot name what is wrong"),  # a wrong shape
+        (lambda x: 1 / 0, "not earned: the check cannot name what is wrong"),  # an exception
+        (_stub, "not written yet"),
+    ):
+        with pytest.raises(CheckFailed, match=f"^double, partial credit: {reason}"):
+            _check_double.partial_credit(wrong)
+
+
+def test_interactively_partial_credit_only_reports(monkeypatch):
+    monkeypatch.delenv("NBGRADER_EXECUTION", raising=False)
+    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
+    r = _check_double.partial_credit(lambda x: 3 * x)
+    assert not r.passed and "the result is not twice the input" in r.message
+
+
+def test_warnings_of_the_learners_function_are_silenced_while_graded(monkeypatch):
+    # nbgrader scores a grade cell that wrote to stderr as failed
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+
+    def noisy(x):
+        warnings.warn("a library's warning", RuntimeWarning)
+        return 2 * x
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert _check_double(noisy).passed and _check_double.partial_credit(noisy).passed
 
 
 def test_braces_in_the_values_are_not_placeholders(shown, monkeypatch):

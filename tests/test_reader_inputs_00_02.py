@@ -9,27 +9,13 @@ Notebook 01 and 00 share the cleaning step (geomlib.mesh.repair.prepare), so the
 import json
 
 import numpy as np
-import pytest
 import sympy as sp
-from awkward_meshes import make_all
 from meshdata import COURSE, ROOT, needs_course
-from notebook_runner import Raw, run_notebook
+from notebook_runner import Raw, ran
 
 from geomlib.teaching import surfaces
 
 NB00, NB01, NB02 = "00_getting_started.ipynb", "01_uniform_laplace_curvature.ipynb", "02_fundamental_forms.ipynb"
-
-
-@pytest.fixture(scope="module")
-def awkward(tmp_path_factory):
-    return {name: str(path) for name, path in make_all(tmp_path_factory.mktemp("awkward")).items()}
-
-
-def ran(name, **parameters):
-    run = run_notebook(name, **parameters)
-    run.assert_ran()
-    print(f"{name} {parameters}: {run.seconds:.1f} s, {len(run.notes)} notes")
-    return run
 
 
 def test_saddle_height_stated_in_01_is_the_code():
@@ -38,7 +24,7 @@ def test_saddle_height_stated_in_01_is_the_code():
     source = next("".join(c["source"]) for c in nb["cells"] if "SADDLE_HEIGHT =" in "".join(c["source"]))
     statement = next(line for line in source.splitlines() if line.startswith("SADDLE_HEIGHT ="))
     x, y, A, B = sp.symbols("x y A B", real=True)
-    expression = sp.sympify(statement.split("=", 1)[1], locals={"x_": x, "y_": y, "A_": A, "B_": B, "sp": sp})
+    expression = sp.sympify(statement.split("=", 1)[1], locals={"x_": x, "y_": y, "mu_": A, "nu_": B, "sp": sp})
     h = sp.lambdify((x, y, A, B), expression, "numpy")
     rng = np.random.default_rng(0)
     x, y = rng.uniform(-1, 1, (2, 500))
@@ -115,5 +101,12 @@ def test_02_spheroid_at_the_ends_of_the_ranges(awkward):
 def test_course_meshes():
     run = ran(NB00, MESH=str(COURSE / "curvatures" / "plane.obj"))
     assert "never fold" in run.outputs_text() and not run.notes, run.notes
+    assert "$H$ from 0 to 0 1/length" in run.outputs_text()  # rounding noise reads as 0, not as -1e-15
+    # the flat grid: rounding noise (|K| <= 8e-13) is no "K < 0", and no H prints as "-0"
+    run = ran(NB01, MESH=str(COURSE / "curvatures" / "plane.obj"))
+    text = run.outputs_text()
+    assert "uniform H: 0 .. 0" in text and "K: 0 .. 0 1/length^2" in text and "-0 .." not in text
+    assert "0 interior vertices have $K > 0$ (curved like a bowl),\n0 have $K < 0$" in text
+    assert "64 have $K = 0$ up to rounding" in text and not run.notes, run.notes
     run = ran(NB01, MESH=str(COURSE / "curvatures" / "lilium_s.obj"), PLANE=str(COURSE / "curvatures" / "plane.obj"))
     assert not run.notes, run.notes

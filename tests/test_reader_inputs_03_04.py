@@ -10,22 +10,9 @@ import re
 
 from awkward_meshes import cad_part, scan_with_holes, two_components, y_up_millimetres
 from meshdata import COURSE, needs_course
-from notebook_runner import run_notebook
+from notebook_runner import ran
 
 NB03, NB04 = "03_cotangent_laplace.ipynb", "04_spectral_reconstruction.ipynb"
-
-
-def ran(name, **parameters):
-    run = run_notebook(name, **parameters)
-    run.assert_ran()
-    print(f"{name} {parameters}: {run.seconds:.1f} s, {len(run.notes)} notes")
-    return run
-
-
-def said(run, *phrases):
-    text = "\n".join(run.notes)
-    for phrase in phrases:
-        assert phrase in text, f"no note says {phrase!r}; the notes were:\n{text}"
 
 
 def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
@@ -40,8 +27,7 @@ def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
         SADDLE_JITTER=0.0,
         AXES=(1.0, 0.7, 0.5),
     )
-    said(
-        run,
+    run.assert_said(
         "12 vertices are not used by any face",
         "geomlib.mesh.repair.remove_unreferenced_vertices",
         "does not converge on jittered meshes",
@@ -63,7 +49,7 @@ def test_03_two_components_sphere_axes_and_high_ends(tmp_path):
         SADDLE_JITTER=0.35,
         SEED=7,
     )
-    said(run, "A slope needs at least two levels")
+    run.assert_said("A slope needs at least two levels")
     assert not re.search(r"\bnan\b", run.outputs_text()), "a number printed as nan"
 
 
@@ -71,20 +57,20 @@ def test_03_cad_part_long_ellipsoid(tmp_path):
     run = ran(
         NB03, MESH=str(cad_part(tmp_path)), LEVELS=[1, 2], AXES=(3.0, 1.0, 0.2), JITTER=0.3, VIEW_LEVEL=2, SADDLE_N=16
     )
-    said(run, "over levels [1, 2]")
+    run.assert_said("over levels [1, 2]")
 
 
 def test_04_scan_with_unused_vertices(tmp_path):
     # issue 11: unused vertices gave divide-by-zero warnings, NaN in S, then an assert
     run = ran(NB04, MESH=str(scan_with_holes(tmp_path)), K_VALUES=(1, 2, 30), SPHERE_LEVEL=3, SMALL_LEVEL=0)
-    said(run, "12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
+    run.assert_said("12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
     text = run.outputs_text()
     assert "divide by zero" not in text and "invalid value" not in text
 
 
 def test_04_two_components_k_beyond_n_and_high_ends(tmp_path):
     run = ran(NB04, MESH=str(two_components(tmp_path)), K_VALUES=(5, 15, 5000), SPHERE_LEVEL=6, SMALL_LEVEL=3)
-    said(run, "at most 1284 eigenvectors exist; k is capped at 1284")
+    run.assert_said("at most 1284 eigenvectors exist; k is capped at 1284")
 
 
 def test_04_y_up_millimetres(tmp_path):

@@ -7,25 +7,15 @@ components, a large CUBE, steps past every limit, absolute and scale-free units)
 """
 
 import pytest
-from awkward_meshes import make_all
 from meshdata import COURSE, needs_course
-from notebook_runner import run_notebook
+from notebook_runner import ran
 
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def awkward(tmp_path_factory):
-    return {name: str(path) for name, path in make_all(tmp_path_factory.mktemp("awkward")).items()}
-
-
-def notes_of(run):
-    return "\n".join(run.notes)
-
-
 @needs_course
 def test_05_course_meshes_with_the_assignments_absolute_step():
-    run = run_notebook(
+    run = ran(
         "05_explicit_smoothing.ipynb",
         PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
         PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
@@ -36,22 +26,47 @@ def test_05_course_meshes_with_the_assignments_absolute_step():
         ITERATIONS=0,
         CUBE_STEPS=1,
     )
-    run.assert_ran()
-    text, notes = run.outputs_text(), notes_of(run)
+    text, notes = run.outputs_text(), run.notes_text()
     # the conversion table: 1e-5 is 0.0278 of fandisk_ns's limit and 2.1 times plane_ns's
     assert "| part | assignment's 1e-05 | 1e-05 | 0.000833 | 0.02782 |" in text
     assert "| plane | assignment's 1e-06 | 1e-06 | 0.03545 | 0.2118 |" in text
     assert "past the cotangent limit on plane" in notes
     # the fixed boundary: the raw top coefficient settles instead of decaying, and the text says why
     assert "settles" in text and "fixed boundary vertices" in text
-    # plane_ns is a regular grid: uniform weights have nothing to slide, and the note says so
-    assert "a regular grid, with equal valences and equal triangles, has nothing to even out" in notes
+    # plane_ns is a regular grid: uniform weights have nothing to slide, and the text says so (no note)
+    assert "flattened, this plane's triangulation is already even" in text
+    assert "it evens out the triangles" not in text
     assert "PART's diagonal is 28.2 times PLANE's" in text
-    assert len(run.notes) == 2, run.notes  # the step past plane_ns's limit, and the regular grid
+    assert len(run.notes) == 1, run.notes  # the step past plane_ns's limit
+
+
+@needs_course
+def test_05_one_step_per_mesh_runs_the_assignments_task_5_in_one_go():
+    # task 5: explicit 1e-4 on fandisk_ns and 1e-6 on plane_ns; one STEP for both made the plane diverge
+    run = ran(
+        "05_explicit_smoothing.ipynb",
+        PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+        PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
+        STEP={"PLANE": 1e-6, "PART": 1e-4},
+        STEP_UNIT="length^2",
+        BREAK_MARGIN=0.3,
+        BREAK_ITERATIONS=20,
+        ITERATIONS=50,
+        CUBE_STEPS=1,
+    )
+    text, notes = run.outputs_text(), run.notes_text()
+    assert "| plane | STEP = 1e-06 length^2 | 1e-06 | 0.03545 | 0.2118 |" in text
+    assert "| part | STEP = 0.0001 length^2 | 0.0001 | 0.00833 | 0.2782 |" in text
+    assert "| cube | STEP = 1e-06 length^2 |" in text  # left out of the dict: the smallest step given
+    assert "past the cotangent limit" not in notes
+    # the live cell runs both at once, each below its own limit
+    assert "plane: tau = 1e-06 = 0.212 x limit, stable" in text
+    assert "part: tau = 0.0001 = 0.278 x limit, stable" in text
+    assert "diverged, stopped at the last finite iterate" not in text
 
 
 def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
-    run = run_notebook(
+    run = ran(
         "05_explicit_smoothing.ipynb",
         PLANE=awkward["y_up_millimetres"],
         PART=awkward["two_components"],
@@ -62,8 +77,7 @@ def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
         ITERATIONS=1000,
         CUBE_STEPS=50,
     )
-    run.assert_ran()
-    notes = notes_of(run)
+    notes = run.notes_text()
     assert "2 connected components" in notes and "largest_component" in notes
     assert "CUBE has 6209 vertices" in notes
     assert "past the cotangent limit on cube, plane, part" in notes
@@ -74,7 +88,7 @@ def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
 
 @needs_course
 def test_06_course_meshes_with_the_assignments_absolute_step():
-    run = run_notebook(
+    run = ran(
         "06_implicit_smoothing.ipynb",
         PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
         PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
@@ -83,15 +97,31 @@ def test_06_course_meshes_with_the_assignments_absolute_step():
         ITERATIONS=1,
         SMOOTHING_TIME=0.1,
     )
-    run.assert_ran()
     text = run.outputs_text()
     assert "| part | assignment's 1e-05 | | | | 1e-05 | 0.000833 | 0.02782 |" in text
     # T = 0.1 ell^2 takes 4 explicit steps, each near the limit: they damp the top mode less than usual
     assert len(run.notes) == 1 and "near the limit an explicit step damps the top mode only by" in run.notes[0]
 
 
+@needs_course
+def test_06_one_step_per_mesh():
+    run = ran(
+        "06_implicit_smoothing.ipynb",
+        PLANE=str(COURSE / "smoothing" / "plane_ns.obj"),
+        PART=str(COURSE / "smoothing" / "fandisk_ns.obj"),
+        STEP={"PLANE": 1e-6, "PART": 1e-4},
+        STEP_UNIT="length^2",
+        ITERATIONS=1,
+        SMOOTHING_TIME=0.1,
+    )
+    text = run.outputs_text()
+    assert "| 1e-06 | 0.03545 | 0.2118 |" in text and "| 0.0001 | 0.00833 | 0.2782 |" in text
+    assert "steps of STEP = {CUBE: 1e-06, PLANE: 1e-06, PART: 0.0001, SPHERE: 1e-06} (length^2)" in text
+    assert "tau = 0.0001 (0.278 x the explicit limit)" in text  # the live view smooths PART with its own step
+
+
 def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
-    run = run_notebook(
+    run = ran(
         "06_implicit_smoothing.ipynb",
         PLANE=awkward["scan_with_holes"],
         PART=awkward["scan_with_holes"],
@@ -101,8 +131,7 @@ def test_06_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
         ITERATIONS=50,
         SMOOTHING_TIME=100.0,
     )
-    run.assert_ran()
-    notes = notes_of(run)
+    notes = run.notes_text()
     assert "not used by any face" in notes and "remove_unreferenced_vertices" in notes
     assert "2 connected components" in notes and "largest_component" in notes
     assert "PART is open: it encloses no volume" in notes

@@ -13,12 +13,12 @@ from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_li
 from geomlib.lessons.smoothing import (
     ExplicitSmoother,
     ImplicitSmoother,
-    _volume_centroid,
     explicit_step,
     fixed_point,
     highest_frequency_mode,
     implicit_step,
 )
+from geomlib.mesh.geometry import volume_and_centroid
 from geomlib.mesh.topology import boundary_vertices
 
 
@@ -67,11 +67,11 @@ def plane_distance(V):
 def test_plane_stays_planar(weights, boundary):
     V, F = grid(12, jitter=0.6)
     V = tilt(V)
-    limit = explicit_step_limit(V, F, weights, boundary=boundary)
-    P = explicit_smoothing(V, F, 0.9 * limit, 20, weights, boundary=boundary)
+    limit = explicit_step_limit(V, F, weights, boundary_condition=boundary)
+    P = explicit_smoothing(V, F, 0.9 * limit, 20, weights, boundary_condition=boundary)
     assert plane_distance(P) < 1e-12
     assert np.abs(P - V).max() > 1e-3  # it did move (in the plane)
-    Q = implicit_smoothing(V, F, 50 * limit, 5, weights, boundary=boundary)
+    Q = implicit_smoothing(V, F, 50 * limit, 5, weights, boundary_condition=boundary)
     assert plane_distance(Q) < 1e-12
 
 
@@ -113,9 +113,9 @@ def test_fixed_point_of_a_closed_mesh_is_the_area_weighted_centroid():
 def test_fixed_boundary_stays_and_free_boundary_moves():
     V, F = grid(10, jitter=0.5)
     b = _boundary_mask(F, len(V))
-    P = implicit_smoothing(V, F, 0.01, 3, boundary="fixed")
+    P = implicit_smoothing(V, F, 0.01, 3, boundary_condition="fixed")
     assert np.array_equal(P[b], V[b])
-    Q = implicit_smoothing(V, F, 0.01, 3, boundary="free")
+    Q = implicit_smoothing(V, F, 0.01, 3, boundary_condition="free")
     assert np.abs(Q[b] - V[b]).max() > 1e-4
 
 
@@ -127,13 +127,13 @@ def test_fixed_boundary_stays_and_free_boundary_moves():
 def test_sphere_stays_sphere_centred(keep_volume):
     centre = np.array([1.0, -2.0, 0.5])
     V, F = icosphere(3, radius=2.0, centre=centre)
-    vol0, c0 = _volume_centroid(V, F)
+    vol0, c0 = volume_and_centroid(V, F)
     P = implicit_smoothing(V, F, 0.05, 5, keep_volume=keep_volume)
     r = np.linalg.norm(P - centre, axis=1)
     assert r.std() / r.mean() < 1e-3  # still a sphere (the icosphere's own unevenness)
-    _, c = _volume_centroid(P, F)
+    _, c = volume_and_centroid(P, F)
     assert np.abs(c - centre).max() < 1e-12
-    vol, _ = _volume_centroid(P, F)
+    vol, _ = volume_and_centroid(P, F)
     if keep_volume:
         assert abs(vol / vol0 - 1) < 1e-12
         assert np.abs(c - c0).max() < 1e-12
@@ -144,9 +144,9 @@ def test_sphere_stays_sphere_centred(keep_volume):
 
 def test_keep_volume_explicit_smoother_api():
     V, F = icosphere(2)
-    vol0, _ = _volume_centroid(V, F)
+    vol0, _ = volume_and_centroid(V, F)
     P = ImplicitSmoother(V, F).smooth(0.2, 4, keep_volume=True)
-    assert abs(_volume_centroid(P, F)[0] / vol0 - 1) < 1e-12
+    assert abs(volume_and_centroid(P, F)[0] / vol0 - 1) < 1e-12
 
 
 def test_keep_volume_on_open_mesh_is_an_error():
@@ -164,7 +164,7 @@ def test_uniform_step_one_is_neighbour_average(mesh):
     V, F = icosphere(2) if mesh == "sphere" else grid(8, jitter=0.5)
     if mesh == "sphere":
         V = V + 0.02 * np.random.default_rng(1).standard_normal(V.shape)
-    P = explicit_smoothing(V, F, 1.0, 1, "uniform", boundary="free")
+    P = explicit_smoothing(V, F, 1.0, 1, "uniform", boundary_condition="free")
     E = np.unique(np.sort(F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
     total = np.zeros_like(V)
     np.add.at(total, E[:, 0], V[E[:, 1]])
@@ -253,7 +253,9 @@ def test_step_limit_scaling_law():
 def test_step_limit_fixed_boundary_at_least_free():
     V, F = grid(10, jitter=0.5)
     for w in ("cotan", "uniform"):
-        assert explicit_step_limit(V, F, w, boundary="fixed") >= explicit_step_limit(V, F, w, boundary="free")
+        assert explicit_step_limit(V, F, w, boundary_condition="fixed") >= explicit_step_limit(
+            V, F, w, boundary_condition="free"
+        )
 
 
 def test_step_fraction_equals_step():
@@ -376,9 +378,9 @@ def test_explicit_divergence_stops_cleanly():
 @pytest.mark.parametrize("step", [-0.1, float("nan"), float("inf"), "0.1", None, True])
 def test_bad_step(step):
     V, F = icosphere(1)
-    with pytest.raises(MeshError, match="step"):
+    with pytest.raises(MeshError, match="tau"):
         implicit_smoothing(V, F, step, 1)
-    with pytest.raises(MeshError, match="step"):
+    with pytest.raises(MeshError, match="tau"):
         explicit_smoothing(V, F, step, 1) if step is not None else explicit_smoothing(V, F, None, 1)
 
 
@@ -396,7 +398,7 @@ def test_bad_options():
     with pytest.raises(MeshError, match="weights"):
         implicit_smoothing(V, F, 0.1, 1, weights="mean")
     with pytest.raises(MeshError, match="boundary"):
-        explicit_smoothing(V, F, 0.001, 1, boundary="clamped")
+        explicit_smoothing(V, F, 0.001, 1, boundary_condition="clamped")
     with pytest.raises(MeshError, match="exactly one"):
         explicit_smoothing(V, F, 0.001, 1, step_fraction=0.5)
     with pytest.raises(MeshError, match="step_fraction"):
@@ -501,6 +503,65 @@ def test_the_formulas_are_one_step_of_the_smoothers():
     np.testing.assert_allclose(P, implicit_smoothing(V, F, 10 * tau, 1), atol=1e-12)
 
 
+def _wrong_steps(monkeypatch):
+    """Replace the shown steps by ones that also move every vertex by 1 along x: a wrong step to catch."""
+    import geomlib.lessons.smoothing as smoothing
+
+    right_explicit, right_implicit = smoothing.explicit_step, smoothing.implicit_step
+    monkeypatch.setattr(smoothing, "explicit_step", lambda P, M, C, tau: right_explicit(P, M, C, tau) + [1.0, 0, 0])
+    monkeypatch.setattr(
+        smoothing, "implicit_step", lambda P, M, C, tau, solve=None: right_implicit(P, M, C, tau, solve) + [1.0, 0, 0]
+    )
+
+
+@pytest.mark.parametrize("boundary_condition", ["fixed", "free"])
+def test_the_engines_advance_by_the_shown_steps(monkeypatch, boundary_condition):
+    V, F = grid(8, jitter=0.4)
+    V[:, 2] = 0.05 * np.random.default_rng(11).standard_normal(len(V))
+    options = dict(boundary_condition=boundary_condition)
+    tau = 0.5 * explicit_step_limit(V, F, **options)
+    runs = {
+        "explicit_smoothing": lambda: explicit_smoothing(V, F, tau, 3, **options),
+        "ExplicitSmoother": lambda: ExplicitSmoother(V, F, **options).smooth(tau, 3),
+        "implicit_smoothing": lambda: implicit_smoothing(V, F, 10 * tau, 3, **options),
+        "implicit_smoothing cg": lambda: implicit_smoothing(V, F, 10 * tau, 3, solver="cg", **options),
+        "implicit_smoothing rebuilt": lambda: implicit_smoothing(V, F, 10 * tau, 3, rebuild=True, **options),
+        "ImplicitSmoother": lambda: ImplicitSmoother(V, F, **options).smooth(10 * tau, 3),
+    }
+    right = {name: run() for name, run in runs.items()}
+    _wrong_steps(monkeypatch)
+    for name, run in runs.items():
+        np.testing.assert_allclose(run()[:, 0] - right[name][:, 0], 3.0, atol=1e-9, err_msg=name)
+
+
+def test_the_sweep_advances_by_the_shown_steps(monkeypatch):
+    from geomlib.teaching.sweep import smoothing_sweep
+
+    V, F = icosphere(1)
+
+    def sweep():
+        return smoothing_sweep(
+            V, F, [0.01], seed=1, explicit_fractions=[0.5], implicit_steps=[0.3], iterations=[1, 2], progress=False
+        )
+
+    right = sweep().values["rms"]
+    _wrong_steps(monkeypatch)
+    wrong = sweep().values["rms"]
+    assert np.isfinite(right).all() and np.isfinite(wrong).all()
+    assert (wrong > right + 0.1).all()  # every scheme moved by 1 per step, about 0.5 of the diagonal
+
+
+def test_the_operator_is_built_once_per_mesh_and_options():
+    from geomlib.lessons.operator import laplace_operator
+
+    V, F = icosphere(2)
+    L = laplace_operator(V, F)
+    assert laplace_operator(V.copy(), F.copy()) is L
+    assert ExplicitSmoother(V, F).L is L and ImplicitSmoother(V, F).L is L
+    assert laplace_operator(V, F, "uniform") is not L
+    assert laplace_operator(V + 1e-9, F) is not L  # the key is the mesh's bytes
+
+
 def test_not_positive_definite_is_a_clear_error():
     from geomlib.numerics.factor import factorise
 
@@ -558,8 +619,8 @@ def test_smoother_history_matches_fresh_runs():
     np.testing.assert_allclose(seven, implicit_smoothing(V, F, 0.05, 7), atol=1e-14)
     three[:] = 0.0  # a returned array is the caller's
     np.testing.assert_allclose(S.smooth(0.05, 3), implicit_smoothing(V, F, 0.05, 3), atol=1e-14)
-    vol0 = _volume_centroid(V, F)[0]
-    assert abs(_volume_centroid(S.smooth(0.05, 4, keep_volume=True), F)[0] / vol0 - 1) < 1e-12
+    vol0 = volume_and_centroid(V, F)[0]
+    assert abs(volume_and_centroid(S.smooth(0.05, 4, keep_volume=True), F)[0] / vol0 - 1) < 1e-12
     assert not np.allclose(five, S.smooth(0.05, 5, keep_volume=True))
 
 
@@ -593,3 +654,22 @@ def test_prepare_shows_progress_when_long(monkeypatch, capsys):
     monkeypatch.setattr(progress, "SECONDS", 0.0)
     ImplicitSmoother(V, F).prepare([0.01, 0.1, 1.0], iterations=2)
     assert "factorising the step values" in capsys.readouterr().err
+
+
+def test_design_contract_calls_keep_working():
+    V, F = icosphere(2)
+    tau = 0.3 * explicit_step_limit(V, F)
+    P = explicit_smoothing(V, F, tau, 3, weights="uniform")  # explicit_smoothing(V, F, step, iterations, weights=...)
+    np.testing.assert_array_equal(explicit_smoothing(V, F, step=tau, iterations=3, weights="uniform"), P)
+    Q = implicit_smoothing(V, F, tau, 3, "cotan")
+    np.testing.assert_array_equal(implicit_smoothing(V, F, step=tau, iterations=3, weights="cotan"), Q)
+    with pytest.raises(MeshError, match="once"):
+        explicit_smoothing(V, F, tau, 3, step=tau)
+
+
+def test_an_unknown_option_names_the_option_the_value_and_the_choices():
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match=r"boundary_condition must be one of 'fixed', 'free', not 'clamped'"):
+        implicit_smoothing(V, F, 0.1, 1, boundary_condition="clamped")
+    with pytest.raises(MeshError, match=r"solver must be one of 'cholesky', 'cg', not 'lu'"):
+        implicit_smoothing(V, F, 0.1, 1, solver="lu")

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from partials import central_partials
 
 from geomlib import MeshError
 from geomlib.teaching import surfaces as S
@@ -39,11 +40,7 @@ def fundamental_truth(p, u, v, outward, h=1e-4):
     ``outward(u, v)`` gives a vector on the outward side; H > 0 where the
     surface bends away from the chosen normal (sphere: outward normal, H = 1/r).
     """
-    pu = (p(u + h, v) - p(u - h, v)) / (2 * h)
-    pv = (p(u, v + h) - p(u, v - h)) / (2 * h)
-    puu = (p(u + h, v) - 2 * p(u, v) + p(u - h, v)) / h**2
-    pvv = (p(u, v + h) - 2 * p(u, v) + p(u, v - h)) / h**2
-    puv = (p(u + h, v + h) - p(u + h, v - h) - p(u - h, v + h) + p(u - h, v - h)) / (4 * h * h)
+    pu, pv, puu, puv, pvv = central_partials(p, u, v, h)
     n = np.cross(pu, pv)
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     n *= np.sign(np.einsum("ij,ij->i", n, outward(u, v)))[:, None]

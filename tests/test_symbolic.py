@@ -9,6 +9,7 @@ normal section cut by a plane and measured by root finding, and laws
 import numpy as np
 import pytest
 import sympy as sp
+from partials import central_partials
 from scipy.optimize import brentq
 
 from geomlib import symbolic
@@ -39,11 +40,7 @@ def p_saddle(u, v):
 
 def fd_forms(p, u, v, h=1e-4):
     """E, F, G, e, f, g and the unit normal m = p_u x p_v/|.| by central differences."""
-    pu = (p(u + h, v) - p(u - h, v)) / (2 * h)
-    pv = (p(u, v + h) - p(u, v - h)) / (2 * h)
-    puu = (p(u + h, v) - 2 * p(u, v) + p(u - h, v)) / h**2
-    pvv = (p(u, v + h) - 2 * p(u, v) + p(u, v - h)) / h**2
-    puv = (p(u + h, v + h) - p(u + h, v - h) - p(u - h, v + h) + p(u - h, v - h)) / (4 * h * h)
+    pu, pv, puu, puv, pvv = central_partials(p, u, v, h)
     m = np.cross(pu, pv)
     m /= np.linalg.norm(m)
     first = (pu @ pu, pu @ pv, pv @ pv)

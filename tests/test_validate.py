@@ -6,7 +6,7 @@ import trimesh
 from meshdata import COURSE, needs_course
 
 from geomlib import MeshError, MeshReport, check_mesh, load_mesh
-from geomlib.mesh.validate import as_faces, as_mesh
+from geomlib.mesh.validate import as_faces, as_mesh, repeated_vertex_faces
 
 
 def icosahedron():
@@ -282,3 +282,14 @@ def test_check_mesh_lives_in_report_and_validate_does_not_import_topology():
 
     assert geomlib.check_mesh is geomlib.mesh.report.check_mesh
     assert "topology" not in open(geomlib.mesh.validate.__file__).read()
+
+
+def test_faces_repeating_a_vertex_are_found_in_one_place():
+    V, F = tetrahedron()
+    G = np.vstack([F, [[1, 1, 2], [3, 0, 3]]])
+    np.testing.assert_array_equal(repeated_vertex_faces(G), [4, 5])
+    assert len(repeated_vertex_faces(F)) == 0
+    # a drawing may accept them; every computation refuses them
+    assert as_faces(G, len(V), allow_repeated=True) is not None
+    with pytest.raises(MeshError, match="2 faces repeat a vertex"):
+        as_faces(G, len(V))

@@ -13,6 +13,13 @@ and ``### END SOLUTION``. Each such block becomes, at the same indentation,
 
 where the derivation is the one the check names. Everything else is copied
 unchanged (a course running nbgrader can take notebooks/ as they are).
+
+Every exercise carries nbgrader points in two autograded grade cells after its
+solution cell (metadata ``nbgrader.grade = true``, ``locked``, ``points``):
+``check.NAME(my_fn)`` (grade id ``NAME_check``) and
+``check.NAME.partial_credit(my_fn)`` (``NAME_partial_credit``). The build
+refuses a notebook whose exercise lacks either, so the output is an nbgrader
+release as it stands.
 The output folder holds the notebooks and a copy of nothing else: they import
 geomlib from the installed package and find the shipped meshes through it.
 """
@@ -51,6 +58,34 @@ def solution_cells(nb):
     ]
 
 
+def exercise_points(nb):
+    """{exercise: points} of a notebook, its grade cells' points summed per exercise.
+
+    Raises ValueError naming an exercise without both of its grade cells.
+    """
+    grade = {
+        c.metadata["nbgrader"]["grade_id"]: (c.source, c.metadata["nbgrader"].get("points"))
+        for c in nb.cells
+        if c.cell_type == "code" and c.metadata.get("nbgrader", {}).get("grade")
+    }
+    points = {}
+    for _, cell in solution_cells(nb):
+        exercise = cell.metadata["nbgrader"]["grade_id"]
+        total = 0
+        for suffix, call in (
+            ("_check", f"check.{exercise}("),
+            ("_partial_credit", f"check.{exercise}.partial_credit("),
+        ):
+            source, value = grade.get(exercise + suffix, ("", None))
+            if not source.startswith(call) or not value:
+                raise ValueError(
+                    f"exercise {exercise}: no grade cell {exercise + suffix!r} calling {call}...) with points"
+                )
+            total += value
+        points[exercise] = total
+    return points
+
+
 def build(out):
     sys.path.insert(0, str(ROOT))
     import geomlib.teaching.check as check
@@ -65,6 +100,10 @@ def build(out):
             if checker is None or not hasattr(checker, "reread"):
                 raise SystemExit(f"{path.name}: solution cell {exercise!r} names no check in geomlib.teaching.check")
             cell.source = stub_source(cell.source, exercise, checker.reread)
+        try:
+            exercise_points(nb)
+        except ValueError as exc:
+            raise SystemExit(f"{path.name}: {exc}") from None
         for cell in nb.cells:
             if (
                 cell.cell_type == "code"

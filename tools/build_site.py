@@ -369,6 +369,19 @@ def nav_html(pages, i):
     )
 
 
+def write_page(nb, out, name):
+    """Write the executed notebook ``nb`` as ``out/<name>.html``, a page as the site's (its
+    3D views live, the pinned JavaScript in ``out/assets/``) without the site's links;
+    returns the page's path. Used for one run of a notebook (tools/run_notebook.py)."""
+    out = Path(out)
+    install_assets(out)
+    prepare_for_site(nb)
+    body, _ = exporter().from_notebook_node(nb, resources={"site_nav": "", "metadata": {"name": title_of(nb, name)}})
+    page = out / f"{name}.html"
+    page.write_text(body, encoding="utf-8")
+    return page
+
+
 INDEX = """<!DOCTYPE html>
 <html lang="en">
 <head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1.0">

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Make the meshes the workbook ships (meshes/*.obj and meshes/README.md).
+"""Make the meshes the workbook ships (geomlib/meshes/*.obj and geomlib/meshes/README.md).
 
-    python tools/make_meshes.py                 # every mesh, then meshes/README.md
+    python tools/make_meshes.py                 # every mesh, then geomlib/meshes/README.md
     python tools/make_meshes.py --only sphere   # some of them (README from the files present)
     python tools/make_meshes.py --out DIR       # somewhere else
 
@@ -10,6 +10,11 @@ running it again gives byte-identical files (the tests check this). Every mesh
 is checked before it is written: no zero-area faces, no unused vertices,
 consistently oriented, and for the closed ones every edge shared by exactly two
 faces and a positive enclosed volume (outward normals).
+
+The measurements and checks are geomlib's own public functions (the edge
+table, boundary loops, components, areas, angles, volume, ``add_noise``); only
+the welding of coincident vertices and the renumbering in first-use order belong
+to the generator.
 
 Convention of the files: triangles counter-clockwise seen from outside (from +z
 for the open height fields), 1-based ``f`` lines, one ``v`` line per vertex.
@@ -29,8 +34,19 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, str(ROOT))
 
+from geomlib.lessons.curvature import corner_angles  # noqa: E402
+from geomlib.lessons.noise import add_noise  # noqa: E402
 from geomlib.mesh.errors import MeshError  # noqa: E402
+from geomlib.mesh.geometry import (  # noqa: E402
+    bounding_box_diagonal,
+    enclosed_volume,
+    face_areas,
+    face_cross,
+    mean_edge_length,
+)
+from geomlib.mesh.topology import Topology, boundary_loops, euler_characteristic  # noqa: E402
 from geomlib.teaching import surfaces  # noqa: E402
+from geomlib.teaching.surfaces import grid_faces  # noqa: E402
 
 FLOAT = "%.9g"
 
@@ -60,80 +76,24 @@ def read_obj(path):
     return np.array(V, dtype=np.float64).reshape(-1, 3), np.array(F, dtype=np.int64).reshape(-1, 3)
 
 
-def edge_table(F):
-    """Undirected edges (k, 2) with their face counts, and directed-edge counts."""
-    E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    und, count = np.unique(np.sort(E, axis=1), axis=0, return_counts=True)
-    _, dcount = np.unique(E, axis=0, return_counts=True)
-    return und, count, dcount
-
-
-def components(n, F):
-    """Number of connected components of the vertex-face graph."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]]])
-    A = coo_matrix((np.ones(len(E)), (E[:, 0], E[:, 1])), shape=(n, n))
-    return connected_components(A, directed=False)[0]
-
-
-def boundary_loops(F):
-    """Number of boundary loops (edges used by one face, followed around)."""
-    und, count, _ = edge_table(F)
-    B = und[count == 1]
-    if len(B) == 0:
-        return 0
-    verts = np.unique(B)
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    idx = {v: i for i, v in enumerate(verts.tolist())}
-    r = [idx[v] for v in B[:, 0].tolist()]
-    c = [idx[v] for v in B[:, 1].tolist()]
-    A = coo_matrix((np.ones(len(r)), (r, c)), shape=(len(verts), len(verts)))
-    return connected_components(A, directed=False)[0]
-
-
-def signed_volume(V, F):
-    return float(np.einsum("ij,ij->i", V[F[:, 0]], np.cross(V[F[:, 1]], V[F[:, 2]])).sum() / 6.0)
-
-
-def face_areas(V, F):
-    return 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
-
-
-def triangle_angles(V, F):
-    """(m, 3) interior angles in degrees."""
-    P = V[F]
-    out = []
-    for i in range(3):
-        e1 = P[:, (i + 1) % 3] - P[:, i]
-        e2 = P[:, (i + 2) % 3] - P[:, i]
-        c = np.einsum("ij,ij->i", e1, e2) / (np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1))
-        out.append(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
-    return np.stack(out, axis=1)
-
-
 def stats(V, F):
-    """The numbers the README table shows, computed from (V, F)."""
-    und, count, dcount = edge_table(F)
-    L = np.linalg.norm(V[und[:, 0]] - V[und[:, 1]], axis=1)
-    closed = bool(np.all(count == 2))
-    ang = triangle_angles(V, F)
+    """The numbers the README table shows, computed from (V, F) by geomlib."""
+    T = Topology(F, len(V))
+    closed = bool(np.all(T.edge_face_count == 2))
+    angles = np.degrees(corner_angles(V, F))
     return dict(
         vertices=int(V.shape[0]),
         faces=int(F.shape[0]),
-        edges=int(und.shape[0]),
-        euler=int(V.shape[0] - und.shape[0] + F.shape[0]),
+        edges=int(len(T.E)),
+        euler=int(euler_characteristic(V, F)),
         closed=closed,
-        boundary_loops=int(boundary_loops(F)),
-        components=int(components(V.shape[0], F)),
-        bbox_diagonal=float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))),
-        mean_edge=float(L.mean()),
-        min_angle=float(ang.min()),
-        obtuse_percent=float(100.0 * np.mean(ang.max(axis=1) > 90.0 + 1e-9)),
-        volume=signed_volume(V, F) if closed else None,
+        boundary_loops=len(boundary_loops(F)),
+        components=int(T.vertex_components().max() + 1),
+        bbox_diagonal=bounding_box_diagonal(V),
+        mean_edge=mean_edge_length(V, F),
+        min_angle=float(angles.min()),
+        obtuse_percent=float(100.0 * np.mean(angles.max(axis=1) > 90.0 + 1e-9)),
+        volume=enclosed_volume(V, F) if closed else None,
     )
 
 
@@ -146,20 +106,20 @@ def check_mesh(name, V, F, closed):
     if np.unique(F).size != V.shape[0] or F.min() != 0:
         raise MeshError(f"{name}: unused vertices")
     A = face_areas(V, F)
-    und, count, dcount = edge_table(F)
-    h = np.linalg.norm(V[und[:, 0]] - V[und[:, 1]], axis=1).mean()
+    T = Topology(F, len(V))
+    h = mean_edge_length(V, F)
     if A.min() <= 1e-6 * h * h:
         raise MeshError(f"{name}: {np.sum(A <= 1e-6 * h * h)} (near) zero-area faces")
-    if np.any(count > 2):
+    if np.any(T.edge_face_count > 2):
         raise MeshError(f"{name}: non-manifold edges")
-    if np.any(dcount > 1):
+    if len(T.inconsistent_edges()):
         raise MeshError(f"{name}: inconsistently oriented faces")
     if np.unique(np.round(V, 12), axis=0).shape[0] != V.shape[0]:
         raise MeshError(f"{name}: duplicate vertex positions")
     if closed:
-        if not np.all(count == 2):
-            raise MeshError(f"{name}: not closed ({np.sum(count == 1)} boundary edges)")
-        if signed_volume(V, F) <= 0:
+        if not np.all(T.edge_face_count == 2):
+            raise MeshError(f"{name}: not closed ({np.sum(T.edge_face_count == 1)} boundary edges)")
+        if enclosed_volume(V, F) <= 0:
             raise MeshError(f"{name}: faces point inwards")
 
 
@@ -194,24 +154,6 @@ def compact(V, F):
     new = np.full(V.shape[0], -1, dtype=np.int64)
     new[order] = np.arange(order.size)
     return V[order], new[F]
-
-
-def vertex_normals(V, F):
-    """Area-weighted unit vertex normals."""
-    FN = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    N = np.zeros_like(V)
-    for k in range(3):
-        np.add.at(N, F[:, k], FN)
-    return N / np.linalg.norm(N, axis=1, keepdims=True)
-
-
-def normal_noise(V, F, sigma, seed):
-    """V + s z n: z standard normal per vertex, n the area-weighted unit vertex
-    normal, s = sigma * bounding-box diagonal (the convention of
-    geomlib.add_noise(..., direction="normal"))."""
-    s = sigma * np.linalg.norm(V.max(axis=0) - V.min(axis=0))
-    z = np.random.default_rng(seed).standard_normal(V.shape[0])
-    return V + s * z[:, None] * vertex_normals(V, F)
 
 
 # ---------------------------------------------------------------------------
@@ -312,7 +254,7 @@ def creature():
     V = lo + h * verts.astype(np.float64)
     F = faces.astype(np.int64)
     V, F = weld(V, F, 1e-9 * h)  # rule 2
-    if signed_volume(V, F) < 0:  # rule 3
+    if enclosed_volume(V, F) < 0:  # rule 3
         F = F[:, [0, 2, 1]]
     s = stats(V, F)
     if s["components"] != 1 or not s["closed"] or s["euler"] != 2 or s["min_angle"] < 1.0:
@@ -423,8 +365,7 @@ def _planar_patch(outer, holes, h, to3d, normal):
                 raise MeshError(f"cad_part: boundary segment {e} missing from a planar patch")
         start += k
     V = to3d(P)
-    FN = np.cross(V[T[:, 1]] - V[T[:, 0]], V[T[:, 2]] - V[T[:, 0]])
-    flip = FN @ np.asarray(normal) < 0
+    flip = face_cross(V, T) @ np.asarray(normal) < 0
     T[flip] = T[flip][:, [0, 2, 1]]
     return V, T
 
@@ -439,9 +380,8 @@ def _strip(p0, p1, y0, y1, nu, nv, outward):
     z = p0[1] + S * (p1[1] - p0[1])
     y = y0 + T_ * (y1 - y0)
     V = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-    F = surfaces._grid_faces(nu + 1, nv + 1)
-    FN = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    flip = FN @ np.asarray(outward) < 0
+    F = grid_faces(nu + 1, nv + 1)
+    flip = face_cross(V, F) @ np.asarray(outward) < 0
     F[flip] = F[flip][:, [0, 2, 1]]
     return V, F
 
@@ -510,10 +450,9 @@ def cad_part():
     nz = max(1, int(round(bh / h)))
     k, j = np.meshgrid(np.arange(nc), np.arange(nz + 1), indexing="ij")
     wall = np.stack([circle[k.ravel(), 0], circle[k.ravel(), 1], ztop + bh * j.ravel() / nz], axis=1)
-    Fw = surfaces._grid_faces(nc, nz + 1, periodic_u=True)
+    Fw = grid_faces(nc, nz + 1, periodic_u=True)
     radial = wall[:, :2] - np.array([cx, cy])
-    FN = np.cross(wall[Fw[:, 1]] - wall[Fw[:, 0]], wall[Fw[:, 2]] - wall[Fw[:, 0]])
-    flip = np.einsum("ij,ij->i", FN[:, :2], radial[Fw].mean(axis=1)) < 0
+    flip = np.einsum("ij,ij->i", face_cross(wall, Fw)[:, :2], radial[Fw].mean(axis=1)) < 0
     Fw[flip] = Fw[flip][:, [0, 2, 1]]
     parts.append((wall, Fw))
     parts.append(
@@ -546,7 +485,7 @@ def cube():
     for a, b, c, d in quads:
         F += [(a, b, c), (a, c, d)]
     F = np.array(F, dtype=np.int64)
-    if signed_volume(V, F) < 0:
+    if enclosed_volume(V, F) < 0:
         F = F[:, [0, 2, 1]]
     return V, F
 
@@ -664,16 +603,12 @@ SPECS = [
 
 def _noisy_plane():
     V, F = _from_surface(surfaces.plane(n=PLANE_N, size=2.0, jitter=0.3, seed=1))
-    d = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
-    z = np.random.default_rng(2).standard_normal(V.shape[0])
-    V = V.copy()
-    V[:, 2] = NOISE_SIGMA * d * z
-    return V, F
+    return add_noise(V, F, NOISE_SIGMA, seed=2, direction="normal"), F  # the normal is +z: only z moves
 
 
 def _noisy_cad():
     V, F = cad_part()
-    return normal_noise(V, F, NOISE_SIGMA, seed=5), F
+    return add_noise(V, F, NOISE_SIGMA, seed=5, direction="normal"), F
 
 
 def generate(out, names=None, skip_expensive=False, verbose=False):

@@ -37,9 +37,9 @@ import warnings
 import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
-from ..mesh.geometry import face_normals, vertex_normals
+from ..mesh.geometry import vertex_normals
 from ..mesh.topology import boundary_edge_counts, edges_at_unpaired_vertices
-from ..mesh.validate import as_mesh
+from ..mesh.validate import as_mesh, check_choice
 from .laplace import check_options, face_geometry, laplacian, vertex_areas
 
 __all__ = [
@@ -49,8 +49,6 @@ __all__ = [
     "angle_deficit",
     "angle_sums",
     "corner_angles",
-    "vertex_normals",
-    "face_normals",
     "boundary_mask",
     "BOUNDARY_RULES",
     "MEAN_BOUNDARY_RULES",
@@ -99,8 +97,7 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
         Meyer et al. 2003, section 3.5; Desbrun et al. 1999.
     """
     check_options(weights, area)
-    if boundary not in MEAN_BOUNDARY_RULES:
-        raise MeshError(f"boundary must be one of {MEAN_BOUNDARY_RULES}, not {boundary!r}")
+    check_choice("boundary", boundary, MEAN_BOUNDARY_RULES)
     V, F = as_mesh(V, F)
     M, C = laplacian(V, F, weights, area)
     A = M.diagonal()

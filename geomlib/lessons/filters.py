@@ -13,12 +13,20 @@ operator; a pure number for the uniform one):
 * Taubin's pass (Taubin 1995):       (1 - tau_shrink lam)(1 - tau_inflate lam),
   tau_shrink > 0 > tau_inflate, |tau_inflate| slightly larger.
 
-Since 1 / (1 + x) > exp(-x) > 1 - x for every x > 0, an implicit step damps
-every mode less than exact diffusion for the same time, and the explicit step
-more (until it overshoots past x = 1 and diverges past x = 2).
+With x = tau lam, the signed chain 1 / (1 + x) > exp(-x) > 1 - x holds for
+every x > 0: the implicit factor lies above diffusion's, the explicit one below.
+In magnitude, which is what decides how much of a mode is left, only half of it
+holds: an implicit step damps every mode less than exact diffusion for the same
+time, but the explicit step damps more only while |1 - x| < exp(-x), that is
+for x < 1.2785 (the root of x - 1 = exp(-x)). For 1.2785 < x < 2 it damps less
+(at x = 1.8, a step at 0.9 of the limit, |1 - x| = 0.8 against exp(-x) = 0.165),
+past x = 1 it flips the mode's sign, and past x = 2 it amplifies: the limit.
 """
 
 import numpy as np
+
+from ..mesh.errors import MeshError
+from ..mesh.validate import check_choice
 
 __all__ = ["SCHEMES", "mode_factor", "plot_mode_factors"]
 
@@ -38,7 +46,13 @@ def mode_factor(lam, tau, scheme, tau_inflate=None):
     Returns
     -------
     ndarray of the shape of ``lam``.
+
+    Raises
+    ------
+    MeshError
+        An unknown ``scheme``; Taubin's pass without ``tau > 0 > tau_inflate``.
     """
+    check_choice("scheme", scheme, SCHEMES)
     x = tau * np.asarray(lam, dtype=float)
     if scheme == "diffusion":
         return np.exp(-x)
@@ -48,11 +62,12 @@ def mode_factor(lam, tau, scheme, tau_inflate=None):
         return 1.0 / (1.0 + x)
     if scheme == "crank-nicolson":
         return (1.0 - x / 2) / (1.0 + x / 2)
-    if scheme == "taubin":
-        if tau_inflate is None or not tau_inflate < 0 < tau:
-            raise ValueError("Taubin's pass needs tau > 0 (shrink) and tau_inflate < 0 (inflate)")
-        return (1.0 - x) * (1.0 - tau_inflate * np.asarray(lam, dtype=float))
-    raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+    if tau_inflate is None or not tau_inflate < 0 < tau:
+        raise MeshError(
+            f"Taubin's pass needs tau > 0 (shrink) and tau_inflate < 0 (inflate), not tau={tau!r}, "
+            f"tau_inflate={tau_inflate!r}"
+        )
+    return (1.0 - x) * (1.0 - tau_inflate * np.asarray(lam, dtype=float))
 
 
 def plot_mode_factors(lam_min, lam_max, tau, taubin=None, ax=None, title=None):

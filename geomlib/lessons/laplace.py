@@ -26,6 +26,11 @@ Policy for bad triangles (never a NaN or an infinity in ``M`` or ``C``):
   ``M`` say so.
 * A non-manifold edge (three or more triangles) gets the sum of all its
   opposite cotangents: ``C`` stays a sum of per-triangle NSD matrices.
+
+Names: a function called ``*_laplacian`` returns the pair ``(M, C)``
+(:func:`laplacian`, :func:`uniform_laplacian`, and the ``cotangent_laplacian``
+a learner writes in notebook 03); one called ``*_matrix`` or ``*_areas``
+returns one matrix or one vector (:func:`cotangent_matrix`, :func:`vertex_areas`).
 """
 
 import warnings
@@ -33,16 +38,15 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
-from ..mesh.errors import MeshError, MeshWarning, format_indices
+from ..mesh.errors import MeshWarning, format_indices
 from ..mesh.geometry import corner_positions, cross
 from ..mesh.topology import edges
-from ..mesh.validate import as_mesh, is_zero_area
+from ..mesh.validate import as_mesh, check_choice, is_zero_area
 
 __all__ = [
     "laplacian",
     "uniform_laplacian",
     "cotangent_matrix",
-    "cotangent_weights",
     "vertex_areas",
     "barycentric_areas",
     "mixed_areas",
@@ -60,11 +64,11 @@ NEXT, PREV = [1, 2, 0], [2, 0, 1]
 
 
 def check_options(weights=None, area=None):
-    """Raise MeshError for a ``weights`` or ``area`` that geomlib does not know."""
-    if weights is not None and weights not in WEIGHTS:
-        raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
-    if area is not None and area not in AREAS:
-        raise MeshError(f"area must be 'barycentric' or 'mixed', not {area!r}")
+    """Raise MeshError for a ``weights`` or ``area`` that geomlib does not know (None: not checked)."""
+    if weights is not None:
+        check_choice("weights", weights, WEIGHTS)
+    if area is not None:
+        check_choice("area", area, AREAS)
 
 
 def face_geometry(V, F):
@@ -98,8 +102,13 @@ def face_geometry(V, F):
     return l2.T, dblA, cot.T, degenerate
 
 
-def warn_zero_area(degenerate):
-    """One MeshWarning naming the zero-area faces, if there are any."""
+def measured_faces(V, F):
+    """:func:`face_geometry`, with one MeshWarning naming the zero-area faces, if there are any.
+
+    They contribute nothing to the cotangent Laplacian and the vertex areas.
+    """
+    faces = face_geometry(V, F)
+    degenerate = faces[3]
     if degenerate.any():
         idx = np.flatnonzero(degenerate)
         warnings.warn(
@@ -108,6 +117,7 @@ def warn_zero_area(degenerate):
             MeshWarning,
             stacklevel=3,
         )
+    return faces
 
 
 def uniform_laplacian(V, F):
@@ -135,18 +145,18 @@ def uniform_laplacian(V, F):
     return sp.diags(valence), C
 
 
-def cotangent_matrix(V, F):
+def cotangent_matrix(V, F, faces=None):
     """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
 
     Triangle ``(v0, v1, v2)`` adds ``1/2 cot theta_i`` to the edge ``(j, k)``
     opposite its corner i. A boundary edge has one triangle, so one angle:
     ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
+    ``faces``: :func:`face_geometry` of (V, F) when the caller has it already.
     Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
     """
     V, F = as_mesh(V, F)
     n = len(V)
-    _, _, cot, degenerate = face_geometry(V, F)
-    warn_zero_area(degenerate)
+    _, _, cot, _ = faces or measured_faces(V, F)
     index = np.int32 if n < 2**31 - 1 else np.int64
     j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
     w = 0.5 * cot.T.ravel()  # gets 1/2 cot theta_i
@@ -156,20 +166,19 @@ def cotangent_matrix(V, F):
     return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
 
 
-def barycentric_areas(V, F):
+def barycentric_areas(V, F, faces=None):
     """(n,) vertex areas A_i in length^2: a third of the area of every incident triangle.
 
     Zero-area triangles add 0 (MeshWarning), so a vertex in no other triangle
-    has area 0. Sums to the surface area.
+    has area 0. Sums to the surface area. ``faces`` as in :func:`cotangent_matrix`.
     """
     V, F = as_mesh(V, F)
-    _, dblA, _, degenerate = face_geometry(V, F)
-    warn_zero_area(degenerate)
+    _, dblA, _, degenerate = faces or measured_faces(V, F)
     third = np.where(degenerate, 0.0, dblA / 6.0)
     return np.bincount(F.T.ravel(), np.tile(third, 3), minlength=len(V))
 
 
-def mixed_areas(V, F):
+def mixed_areas(V, F, faces=None):
     """(n,) mixed Voronoi vertex areas A_i in length^2 (Meyer et al. 2003, Fig. 4).
 
     Per triangle and corner i (j, k the other two corners, A the triangle area):
@@ -180,10 +189,10 @@ def mixed_areas(V, F):
     * obtuse at another corner: ``A / 4``.
 
     Sums to the surface area. Zero-area triangles add 0 (MeshWarning).
+    ``faces`` as in :func:`cotangent_matrix`.
     """
     V, F = as_mesh(V, F)
-    l2, dblA, cot, degenerate = face_geometry(V, F)
-    warn_zero_area(degenerate)
+    l2, dblA, cot, degenerate = faces or measured_faces(V, F)
     A = 0.5 * dblA[:, None]
     lc = l2 * cot
     voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
@@ -194,14 +203,15 @@ def mixed_areas(V, F):
     return np.bincount(F.T.ravel(), per_corner.T.ravel(), minlength=len(V))
 
 
-def vertex_areas(V, F, area="barycentric"):
+def vertex_areas(V, F, area="barycentric", faces=None):
     """(n,) vertex areas A_i in length^2, the diagonal of the cotangent M.
 
     ``area="barycentric"``: :func:`barycentric_areas`; ``"mixed"``:
     :func:`mixed_areas` (Meyer et al. 2003). Both sum to the surface area.
+    ``faces`` as in :func:`cotangent_matrix`.
     """
     check_options(area=area)
-    return barycentric_areas(V, F) if area == "barycentric" else mixed_areas(V, F)
+    return (barycentric_areas if area == "barycentric" else mixed_areas)(V, F, faces)
 
 
 def laplacian(V, F, weights="cotan", area="barycentric"):
@@ -242,16 +252,8 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     V, F = as_mesh(V, F)
     if weights == "uniform":
         return uniform_laplacian(V, F)
-    C = cotangent_matrix(V, F)  # names the zero-area faces, if any
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", MeshWarning)  # the same faces: named once is enough
-        M = sp.diags(vertex_areas(V, F, area))
-    return M, C
-
-
-def cotangent_weights(V, F):
-    """The cotangent matrix C (n, n); the name the package exports for :func:`cotangent_matrix`."""
-    return cotangent_matrix(V, F)
+    faces = measured_faces(V, F)  # once for both matrices; names the zero-area faces, if any
+    return sp.diags(vertex_areas(V, F, area, faces)), cotangent_matrix(V, F, faces)
 
 
 def uniform_adjacency(n, F):

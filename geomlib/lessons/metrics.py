@@ -137,7 +137,7 @@ def dihedral_angles(V, F, edges=None):
 
 def _bend_angles(V, F, E, f1, f2):
     n1, n2 = face_cross(V, F[f1]), face_cross(V, F[f2])  # only the faces at these edges
-    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), np.einsum("ij,ij->i", n1, n2)))
+    angle = _angles(n1, n2)
     # far vertex of f2: the corner that is neither end of the edge
     G = F[f2]
     far = np.where(
@@ -434,10 +434,15 @@ class MeshComparison:
         return out
 
 
+def _angles(a, b):
+    """Angles (degrees, 0..180) between the rows of a and b: arctan2(|a x b|, a . b), exact near 0 and 180."""
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b)))
+
+
 def _normal_angles(N, N_clean):
     """Angles (degrees) between the rows of two arrays of (unnormalised)
     normals; rows with a zero vector (degenerate faces) count as 90."""
-    angle = np.degrees(np.arctan2(np.linalg.norm(np.cross(N, N_clean), axis=1), np.einsum("ij,ij->i", N, N_clean)))
+    angle = _angles(N, N_clean)
     zero = (np.linalg.norm(N, axis=1) == 0) | (np.linalg.norm(N_clean, axis=1) == 0)
     angle[zero] = 90.0
     return angle

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..mesh.errors import MeshError
 from ..mesh.geometry import bounding_box_diagonal, vertex_normals
-from ..mesh.validate import as_mesh
+from ..mesh.validate import as_mesh, check_choice
 
 __all__ = ["add_noise", "DIRECTIONS"]
 
@@ -52,8 +52,7 @@ def add_noise(V, F, sigma, seed, direction="isotropic"):
         raise MeshError(f"sigma must be a number (a fraction of the bounding-box diagonal), got {sigma!r}") from None
     if not np.isfinite(sigma) or sigma < 0:
         raise MeshError(f"sigma must be finite and >= 0 (a fraction of the bounding-box diagonal), got {sigma}")
-    if direction not in DIRECTIONS:
-        raise MeshError(f"direction must be 'isotropic' or 'normal', not {direction!r}")
+    check_choice("direction", direction, DIRECTIONS)
     if seed is None:
         raise MeshError("seed is required: pass an integer so that the noise can be reproduced")
     rng = np.random.default_rng(seed)

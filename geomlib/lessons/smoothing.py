@@ -11,12 +11,16 @@ moves a vertex against its outward normal where the surface is convex.
   a sparse symmetric positive definite system (Desbrun, Meyer, Schroeder and
   Barr 1999), solved by a Cholesky factorisation (:mod:`geomlib.numerics.factor`).
 
-Units of the step ``tau`` (``step=`` in the functions' arguments): for the
-cotangent operator ``Delta`` has units 1/length^2, so ``tau`` is a time of the
-heat flow in length^2 (scale a mesh by s and the same smoothing needs s^2
-times the step); for the uniform operator it is dimensionless. Scale-free:
-``tau / ell^2`` with ``ell`` the mean edge length, or the fraction of the
-explicit stability limit (``step_fraction=``).
+Every engine here (:func:`explicit_smoothing`, :func:`implicit_smoothing`,
+:class:`ExplicitSmoother`, :class:`ImplicitSmoother`, and through them the sweep
+of notebook 07) advances by calling these two functions, with the operator of
+:func:`geomlib.lessons.operator.laplace_operator` built once per mesh and options.
+
+Units of the step ``tau``: for the cotangent operator ``Delta`` has units
+1/length^2, so ``tau`` is a time of the heat flow in length^2 (scale a mesh by s
+and the same smoothing needs s^2 times the step); for the uniform operator it is
+dimensionless. Scale-free: ``tau / ell^2`` with ``ell`` the mean edge length, or
+the fraction of the explicit stability limit (``step_fraction=``).
 
 Stability of the explicit scheme: an eigenvector component of P (``Delta e =
 -lam e``) is multiplied by ``1 - tau lam`` at every step; it stays bounded iff
@@ -24,11 +28,12 @@ Stability of the explicit scheme: an eigenvector component of P (``Delta e =
 limit is ``2 / lam_max`` (:func:`explicit_step_limit`). For the uniform
 operator ``lam_max <= 2``, so steps up to 1 are always stable.
 
-Boundary (open meshes): ``boundary="fixed"`` (the default) keeps boundary
-vertices where they are (a Dirichlet condition); ``boundary="free"`` moves
-them with the same operator. A vertex with zero vertex area (used by no face,
-or only by zero-area faces) has no Laplacian: every function raises
-MeshError naming it and the call that removes it.
+Boundary condition (open meshes): ``boundary_condition="fixed"`` (the default)
+keeps boundary vertices where they are (a Dirichlet condition: their rows of the
+step are replaced by ``P'_B = P_B``); ``"free"`` moves them with the same
+operator. A vertex with zero vertex area (used by no face, or only by zero-area
+faces) has no Laplacian: every function raises MeshError naming it and the call
+that removes it.
 """
 
 import numbers
@@ -36,17 +41,15 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
-from ..mesh.geometry import bounding_box_diagonal, surface_area
+from ..mesh.geometry import bounding_box_diagonal, surface_area, volume_and_centroid
 from ..mesh.requirements import positive_vertex_areas
 from ..mesh.topology import boundary_vertices
-from ..mesh.validate import as_mesh
-from ..numerics.eigen import largest_eigenpair, largest_eigenvalue
-from ..numerics.factor import factor_seconds, factorise
-from ..numerics.progress import Iterations, Stages
-from .laplace import laplacian
+from ..mesh.validate import as_mesh, check_choice
+from ..numerics.factor import factorise
+from ..numerics.progress import Iterations
+from .operator import SOLVERS, LaplaceOperator, laplace_operator
 
 __all__ = [
     "explicit_step",
@@ -68,9 +71,7 @@ BLOWUP_FACTOR = 1e6
 #: below this fraction of the initial area (the mesh has collapsed).
 COLLAPSE_AREA_FRACTION = 1e-8
 
-_WEIGHTS = ("cotan", "uniform")
-_BOUNDARY = ("fixed", "free")
-_ON_FAILURE = ("raise", "stop")
+ON_FAILURE = ("raise", "stop")
 
 
 # --------------------------------------------------------------------------
@@ -88,18 +89,21 @@ def explicit_step(P, M, C, tau):
     return P + tau * (sp.diags(1.0 / m) @ (C @ P))
 
 
-def implicit_step(P, M, C, tau):
+def implicit_step(P, M, C, tau, solve=None):
     """One implicit (backward Euler) step: solve ``(M - tau C) P' = M P`` for P' (n, 3).
 
     ``M - tau C`` is symmetric positive definite for every ``tau >= 0``, so
     the step is stable for any tau (Desbrun et al. 1999); it is solved by a
-    sparse Cholesky factorisation.
+    sparse Cholesky factorisation, or by ``solve(R)``, a solver of the same
+    system prepared once for many steps.
     """
     positive_vertex_areas(M, None, "implicit_step")
-    return factorise(M - tau * C).solve(M @ P)
+    if solve is None:
+        solve = factorise(M - tau * C).solve
+    return solve(M @ P)
 
 
-def explicit_step_limit(V, F, weights="cotan", area="barycentric", boundary="fixed"):
+def explicit_step_limit(V, F, weights="cotan", area="barycentric", boundary_condition="fixed"):
     """Largest stable step of explicit smoothing: ``2 / lam_max``.
 
     One explicit step multiplies the mode ``Delta e = -lam e`` by ``1 - tau lam``,
@@ -112,7 +116,7 @@ def explicit_step_limit(V, F, weights="cotan", area="barycentric", boundary="fix
     F : (m, 3) int64
     weights : "cotan" or "uniform"
     area : "barycentric" or "mixed" (cotan vertex areas; see :func:`geomlib.laplacian`)
-    boundary : "fixed" or "free"
+    boundary_condition : "fixed" or "free"
         With fixed boundary vertices only the interior block of Delta matters
         (its limit is at least that of the free problem, by eigenvalue interlacing).
 
@@ -124,24 +128,18 @@ def explicit_step_limit(V, F, weights="cotan", area="barycentric", boundary="fix
         ``S = -M^-1/2 C M^-1/2`` on the moving vertices (the spectrum of
         ``-Delta``), by :func:`geomlib.numerics.eigen.largest_eigenvalue` (relative
         accuracy about 1e-8, from below, so the limit is never underestimated).
-        Cached per mesh and options, so a slider calls it for free.
+        Kept with the mesh's operator, so a slider calls it for free.
     """
-    V, F = as_mesh(V, F)
-    _check_choice(weights, "weights", _WEIGHTS)
-    _check_choice(boundary, "boundary", _BOUNDARY)
-    name = ("limit", V.tobytes(), F.tobytes(), weights, area, boundary)
-    if name not in _REMEMBERED:
-        I, m, S = _moving_block(V, F, weights, area, boundary, "explicit_step_limit")
-        lam_max = largest_eigenvalue(S) if len(I) else 0.0
-        _remember(name, 2.0 / lam_max if lam_max > 0 else float("inf"))
-    return _REMEMBERED[name]
+    L = laplace_operator(V, F, weights, area, boundary_condition)
+    L.require_positive_areas(F, "explicit_step_limit")
+    return 2.0 / L.lam_max if L.lam_max > 0 else float("inf")
 
 
-def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="fixed"):
+def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary_condition="fixed"):
     """The highest-frequency eigenpair of the Laplacian: ``Delta e = -lam_max e``.
 
     ``lam_max >= 0`` in 1/length^2 for ``weights="cotan"``, dimensionless for
-    ``"uniform"``. With ``boundary="fixed"`` it is the eigenproblem of the
+    ``"uniform"``. With ``boundary_condition="fixed"`` it is the eigenproblem of the
     interior vertices (boundary values held at zero), the operator the explicit
     scheme iterates. Solved in the symmetric form ``S y = lam y``,
     ``S = -M^-1/2 C M^-1/2`` on the moving vertices, ``e = M^-1/2 y``
@@ -155,20 +153,14 @@ def highest_frequency_mode(V, F, weights="cotan", area="barycentric", boundary="
         magnitude positive. Explicit smoothing multiplies the component
         ``e^T M P`` by ``1 - tau lam_max`` at every step.
     """
-    V, F = as_mesh(V, F)
-    _check_choice(weights, "weights", _WEIGHTS)
-    _check_choice(boundary, "boundary", _BOUNDARY)
-    name = ("mode", V.tobytes(), F.tobytes(), weights, area, boundary)
-    if name not in _REMEMBERED:
-        I, m, S = _moving_block(V, F, weights, area, boundary, "highest_frequency_mode")
-        lam_max, y = largest_eigenpair(S) if len(I) else (0.0, np.zeros(0))
-        e = np.zeros(len(V))
-        e[I] = y / np.sqrt(m[I])  # e = M^-1/2 y, e^T M e = 1
-        if len(I) and e[np.argmax(np.abs(e))] < 0:
-            e = -e
-        _remember(name, (lam_max, e))
-    lam_max, e = _REMEMBERED[name]
-    return lam_max, e.copy()
+    L = laplace_operator(V, F, weights, area, boundary_condition)
+    L.require_positive_areas(F, "highest_frequency_mode")
+    lam_max, y = L.top_mode
+    e = np.zeros(len(L.m))
+    e[L.I] = y / np.sqrt(L.m[L.I])  # e = M^-1/2 y, e^T M e = 1
+    if len(L.I) and e[np.argmax(np.abs(e))] < 0:
+        e = -e
+    return lam_max, e
 
 
 def fixed_point(V, F, weights="cotan", area="barycentric"):
@@ -186,51 +178,30 @@ def fixed_point(V, F, weights="cotan", area="barycentric"):
     P_star : (n, 3) float64, length units.
     """
     V, F = as_mesh(V, F)
-    M, C = laplacian(V, F, weights=weights, area=area)
-    m = M.diagonal()
-    B = boundary_vertices(F, len(V))
-    if len(B) == 0:
-        return np.repeat([m @ V / m.sum()], len(V), axis=0)
-    I = np.setdiff1d(np.arange(len(V)), B)
-    C = C.tocsr()
+    L = laplace_operator(V, F, weights, area, "fixed")
+    if len(L.B) == 0:
+        return np.repeat([L.m @ V / L.m.sum()], len(V), axis=0)
+    C_II, C_IB = L.blocks
     P_star = V.copy()
-    P_star[I] = factorise(-C[I][:, I]).solve(C[I][:, B] @ V[B])  # -C_II is positive definite
+    P_star[L.I] = factorise(-C_II).solve(C_IB @ V[L.B])  # -C_II is positive definite
     return P_star
-
-
-_REMEMBERED = {}
-
-
-def _remember(name, value, size=16):
-    while len(_REMEMBERED) >= size:
-        _REMEMBERED.pop(next(iter(_REMEMBERED)))
-    _REMEMBERED[name] = value
-
-
-def _moving_block(V, F, weights, area, boundary, what):
-    """Moving vertices I, vertex areas m and ``S = -M^-1/2 C M^-1/2`` restricted to I."""
-    M, C = laplacian(V, F, weights=weights, area=area)
-    m = positive_vertex_areas(M, F, what)
-    I = np.flatnonzero(_moving(F, len(V), boundary))
-    D_inv = sp.diags(1.0 / np.sqrt(m[I]))  # M^-1/2 on the moving vertices
-    return I, m, (D_inv @ (-C.tocsr()[I][:, I]) @ D_inv).tocsr()
 
 
 # --------------------------------------------------------------------------
 # argument checks and shared pieces
 
 
-def _check_step(step, name="step"):
-    if isinstance(step, (bool, np.bool_)) or not isinstance(step, numbers.Real):
-        raise MeshError(f"{name} must be a real number, not {type(step).__name__} {step!r}")
-    step = float(step)
-    if not np.isfinite(step):
-        raise MeshError(f"{name} must be finite, not {step!r}")
-    if step < 0:
+def _check_tau(tau, name="tau"):
+    if isinstance(tau, (bool, np.bool_)) or not isinstance(tau, numbers.Real):
+        raise MeshError(f"{name} must be a real number, not {type(tau).__name__} {tau!r}")
+    tau = float(tau)
+    if not np.isfinite(tau):
+        raise MeshError(f"{name} must be finite, not {tau!r}")
+    if tau < 0:
         raise MeshError(
-            f"{name} must be >= 0 (a negative step runs the heat flow backwards and is unstable), not {step!r}"
+            f"{name} must be >= 0 (a negative step runs the heat flow backwards and is unstable), not {tau!r}"
         )
-    return step
+    return tau
 
 
 def _check_iterations(iterations):
@@ -241,18 +212,13 @@ def _check_iterations(iterations):
     return int(iterations)
 
 
-def _check_choice(value, name, choices):
-    if value not in choices:
-        raise MeshError(f"{name} must be one of {', '.join(repr(c) for c in choices)}, not {value!r}")
-    return value
-
-
-def _moving(F, n, boundary):
-    """(n,) bool: the vertices that move (all, or all but the boundary ones)."""
-    moving = np.ones(n, dtype=bool)
-    if boundary == "fixed":
-        moving[boundary_vertices(F, n)] = False
-    return moving
+def _tau_or_step(tau, step):
+    """``tau``, or ``step``, the name DESIGN.md's contract gives the same argument."""
+    if step is None:
+        return tau
+    if tau is not None:
+        raise MeshError("give the step once, as tau (step is the same argument)")
+    return step
 
 
 def _fail(on_failure, message, k, P_last, stacklevel=3):
@@ -274,13 +240,14 @@ def _fail(on_failure, message, k, P_last, stacklevel=3):
 def explicit_smoothing(
     V,
     F,
-    step=None,
+    tau=None,
     iterations=1,
     weights="cotan",
     *,
+    step=None,
     step_fraction=None,
     area="barycentric",
-    boundary="fixed",
+    boundary_condition="fixed",
     progress=None,
     callback=None,
     on_failure="raise",
@@ -290,21 +257,24 @@ def explicit_smoothing(
     Forward Euler on the heat flow ``dP/dt = Delta P`` with ``Delta = M^-1 C``
     (C negative semidefinite, ``Delta x = -2 H n``) built once from V and kept
     fixed; stable only for ``tau < 2 / lam_max`` (:func:`explicit_step_limit`).
+    Every iteration is one :func:`explicit_step`.
 
     Parameters
     ----------
     V : (n, 3) float64
         Vertex positions (not modified).
     F : (m, 3) int64
-    step : float >= 0, optional
-        The step tau: length^2 for ``weights="cotan"``, dimensionless for
-        ``"uniform"``. Give either ``step`` or ``step_fraction``.
+    tau : float >= 0, optional
+        The step: length^2 for ``weights="cotan"``, dimensionless for
+        ``"uniform"``. Give either ``tau`` or ``step_fraction``.
     iterations : int >= 0
     weights : "cotan" or "uniform"
+    step : float >= 0, optional
+        Another name for ``tau`` (the one DESIGN.md's contract uses).
     step_fraction : float >= 0, optional
         The step as a fraction of the stability limit (scale-free): below 1 is stable.
     area : "barycentric" or "mixed"
-    boundary : "fixed" (default) or "free"
+    boundary_condition : "fixed" (default) or "free"
     progress : None, True or False
         Progress bar (tqdm.auto); None: shown when the first iteration predicts
         more than ``geomlib.numerics.progress.SECONDS``.
@@ -324,7 +294,7 @@ def explicit_smoothing(
     Raises
     ------
     MeshError
-        Bad step, step_fraction (both or neither given), iterations or option;
+        Bad tau, step_fraction (both or neither given), iterations or option;
         vertices with zero area; divergence with ``on_failure="raise"``.
 
     Warns
@@ -335,8 +305,8 @@ def explicit_smoothing(
     References: Taubin 1995; Desbrun, Meyer, Schroeder and Barr 1999.
     """
     # _smooth, not smooth: the warnings then name the caller of explicit_smoothing
-    return ExplicitSmoother(V, F, weights, area, boundary)._smooth(
-        step, iterations, step_fraction, progress, callback, on_failure
+    return ExplicitSmoother(V, F, weights, area, boundary_condition)._smooth(
+        _tau_or_step(tau, step), iterations, step_fraction, progress, callback, on_failure
     )
 
 
@@ -345,12 +315,13 @@ class ExplicitSmoother:
 
     :func:`explicit_smoothing` in two parts, for a slider or a sweep that
     smooths one mesh with many steps and iteration counts: the constructor
-    assembles the Laplacian of V (at 164k vertices as long as about 30 steps),
-    and every :meth:`smooth` runs from V with its own step.
+    takes the Laplacian of V (:func:`geomlib.lessons.operator.laplace_operator`;
+    at 164k vertices its assembly costs about 30 steps), and every :meth:`smooth`
+    runs :func:`explicit_step` from V with its own step.
 
     Parameters
     ----------
-    V, F, weights, area, boundary : as in :func:`explicit_smoothing`.
+    V, F, weights, area, boundary_condition : as in :func:`explicit_smoothing`.
 
     Raises
     ------
@@ -358,33 +329,28 @@ class ExplicitSmoother:
         Bad mesh or option; vertices with zero area (named).
     """
 
-    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed"):
-        V, F = as_mesh(V, F)
-        _check_choice(weights, "weights", _WEIGHTS)
-        _check_choice(boundary, "boundary", _BOUNDARY)
-        self.V, self.F = V, F
-        self.weights, self.area, self.boundary = weights, area, boundary
-        M, self.C = laplacian(V, F, weights=weights, area=area)
-        self.m = positive_vertex_areas(M, F, "explicit_smoothing")  # the diagonal of M
-        self.moving = _moving(F, len(V), boundary)
+    def __init__(self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed"):
+        self.V, self.F = as_mesh(V, F)
+        self.L = laplace_operator(self.V, self.F, weights, area, boundary_condition)
+        self.L.require_positive_areas(self.F, "explicit_smoothing")
 
-    def smooth(self, step=None, iterations=1, *, step_fraction=None, progress=None, callback=None, on_failure="raise"):
+    def smooth(self, tau=None, iterations=1, *, step_fraction=None, progress=None, callback=None, on_failure="raise"):
         """Run ``iterations`` explicit steps from V; arguments, result, errors and warnings as in
         :func:`explicit_smoothing`. Returns a new (n, 3) array."""
-        return self._smooth(step, iterations, step_fraction, progress, callback, on_failure)
+        return self._smooth(tau, iterations, step_fraction, progress, callback, on_failure)
 
-    def _smooth(self, step, iterations, step_fraction, progress, callback, on_failure):
+    def _smooth(self, tau, iterations, step_fraction, progress, callback, on_failure):
         # reached from smooth and from explicit_smoothing alike, so that the warnings of _tau and
         # _fail (stacklevel 4) name the reader's line that called either
         iterations = _check_iterations(iterations)
-        _check_choice(on_failure, "on_failure", _ON_FAILURE)
-        tau = self._tau(step, step_fraction)
-        tau_Minv_C = sp.diags(np.where(self.moving, tau / self.m, 0.0)) @ self.C  # tau M^-1 C, zero rows where fixed
+        check_choice("on_failure", on_failure, ON_FAILURE)
+        tau = self._tau(tau, step_fraction)
+        M, C = self.L.M_step, self.L.C_step  # the fixed vertices' rows read P'_B = P_B
         far = BLOWUP_FACTOR * max(bounding_box_diagonal(self.V), np.finfo(float).tiny)
         P, bar = self.V.copy(), Iterations(iterations, progress, "explicit smoothing")
         try:
             for k in range(1, iterations + 1):
-                P_next = P + tau_Minv_C @ P  # P + tau M^-1 C P
+                P_next = explicit_step(P, M, C, tau)
                 if not np.isfinite(P_next).all() or np.abs(P_next - self.V).max() > far:
                     message = (
                         f"explicit smoothing diverged at iteration {k} (step "
@@ -399,24 +365,24 @@ class ExplicitSmoother:
             bar.close()
         return P
 
-    def _tau(self, step, step_fraction):
-        """The step from ``step`` or ``step_fraction``; warns when it exceeds the limit."""
-        if (step is None) == (step_fraction is None):
-            raise MeshError("give exactly one of step and step_fraction")
-        limit_args = (self.V, self.F, self.weights, self.area, self.boundary)
+    def _tau(self, tau, step_fraction):
+        """The step from ``tau`` or ``step_fraction``; warns when it exceeds the limit."""
+        if (tau is None) == (step_fraction is None):
+            raise MeshError("give exactly one of tau and step_fraction")
+        L = self.L
         if step_fraction is not None:
-            limit = explicit_step_limit(*limit_args)
-            return _check_step(step_fraction, "step_fraction") * limit if np.isfinite(limit) else 0.0
-        tau = _check_step(step)
+            fraction = _check_tau(step_fraction, "step_fraction")
+            return fraction * 2.0 / L.lam_max if L.lam_max > 0 else 0.0
+        tau = _check_tau(tau)
         # Gershgorin: lam_max <= max 2 |C_ii| / M_ii, so steps below 2 / that bound are
-        # certainly stable and need no eigenvalue computation.
-        m, c = self.m[self.moving], np.abs(self.C.diagonal()[self.moving])
-        if tau > 0 and self.moving.any() and tau * np.max(2.0 * c / m) > 2.0:
-            limit = explicit_step_limit(*limit_args)
+        # certainly stable and need no eigenvalue computation (L.lam_max computes it on first use).
+        m, c = L.m[L.moving], np.abs(L.C.diagonal()[L.moving])
+        if tau > 0 and L.moving.any() and tau * np.max(2.0 * c / m) > 2.0:
+            limit = 2.0 / L.lam_max if L.lam_max > 0 else float("inf")
             if tau > limit * (1 + 1e-12):
                 warnings.warn(
                     f"explicit step {tau:.6g} exceeds the stability limit {limit:.6g} "
-                    f"(= 2 / lambda_max, {self.weights} weights, boundary {self.boundary}): the "
+                    f"(= 2 / lambda_max, {L.weights} weights, boundary {L.boundary_condition}): the "
                     f"highest-frequency component grows by {abs(1 - 2 * tau / limit):.4g} "
                     f"per iteration",
                     MeshWarning,
@@ -434,94 +400,76 @@ class ImplicitSmoother:
 
     Convention: ``(M - tau C) P' = M P`` with M, C of :func:`geomlib.laplacian`
     built once from V (C negative semidefinite, so the matrix is symmetric
-    positive definite for every tau >= 0). With fixed boundary vertices (B)
-    only the interior (I) is solved: ``(M_II - tau C_II) P'_I = M_I P_I + tau C_IB P_B``.
+    positive definite for every tau >= 0). Every iteration is one
+    :func:`implicit_step`, given the factorised solve of its system; with fixed
+    boundary vertices (B) only the interior (I) is factorised:
+    ``(M_II - tau C_II) P'_I = M_I P_I + tau C_IB P_B``
+    (:meth:`geomlib.lessons.operator.LaplaceOperator.step_solver`).
 
     Meant for sliders (build it outside the callback): every new step value
     costs one sparse Cholesky factorisation (:mod:`geomlib.numerics.factor`), kept for
     the last ``cache_size`` step values, and every iteration one pair of
     triangular solves. :meth:`smooth` also keeps the iterates of the last
-    ``history_size`` (step, keep_volume) settings, so moving an iteration
+    ``history_size`` (tau, keep_volume) settings, so moving an iteration
     slider costs only the iterations not yet computed, and returning to a
     setting seen before costs nothing; :meth:`prepare` does all of this ahead.
 
     Parameters
     ----------
-    V, F, weights, area, boundary : as in :func:`implicit_smoothing`.
+    V, F, weights, area, boundary_condition : as in :func:`implicit_smoothing`.
     cache_size : int
         How many factorisations to keep.
     history_size : int
         For how many settings to keep the iterates (0: none).
     """
 
-    def __init__(self, V, F, weights="cotan", area="barycentric", boundary="fixed", cache_size=16, history_size=4):
-        V, F = as_mesh(V, F)
-        _check_choice(weights, "weights", _WEIGHTS)
-        _check_choice(boundary, "boundary", _BOUNDARY)
-        self.V, self.F = V, F
-        self.weights, self.area, self.boundary = weights, area, boundary
-        M, C = laplacian(V, F, weights=weights, area=area)
-        self.m = positive_vertex_areas(M, F, "ImplicitSmoother")
-        self.moving = _moving(F, len(V), boundary)
-        self.I, B = np.flatnonzero(self.moving), np.flatnonzero(~self.moving)
-        C_I = C.tocsr()[self.I]
-        self.C_II = C_I[:, self.I].tocsr()
-        self.CP_B = C_I[:, B] @ V[B]  # C_IB P_B, constant while P_B stays fixed
+    def __init__(
+        self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed", cache_size=16, history_size=4
+    ):
+        self.V, self.F = as_mesh(V, F)
+        self.L = laplace_operator(self.V, self.F, weights, area, boundary_condition)
+        self.L.require_positive_areas(self.F, "ImplicitSmoother")
         self.cache_size, self.history_size = int(cache_size), int(history_size)
         self._factors, self._history = {}, {}
 
-    def factor(self, step):
-        """The Cholesky factorisation of ``M_II - step C_II`` (cached per step)."""
-        step = _check_step(step)
-        factor = self._factors.pop(step, None)
-        if factor is None:
-            A = sp.diags(self.m[self.I]) - step * self.C_II
-            with Stages(["factorising M - tau C"], factor_seconds(len(self.I)), "implicit smoothing"):
-                try:
-                    factor = factorise(A)
-                except np.linalg.LinAlgError as exc:
-                    raise MeshError(f"implicit smoothing: M - {step:.6g} C is not positive definite ({exc})") from None
-            while len(self._factors) >= self.cache_size:
-                self._factors.pop(next(iter(self._factors)))
-        self._factors[step] = factor  # most recently used last
+    def factor(self, tau):
+        """The Cholesky factorisation of ``M_II - tau C_II`` (cached per tau)."""
+        tau = _check_tau(tau)
+        factor = self._factors.pop(tau, None) or self.L.factorise(tau)
+        while len(self._factors) >= self.cache_size:
+            self._factors.pop(next(iter(self._factors)))
+        self._factors[tau] = factor  # most recently used last
         return factor
 
-    def prepare(self, steps, iterations=0, keep_volume=False):
-        """Factorise for every step value in ``steps`` now (e.g. all positions of a slider),
+    def prepare(self, taus, iterations=0, keep_volume=False):
+        """Factorise for every step value in ``taus`` now (e.g. all positions of a slider),
         and with ``iterations > 0`` also compute and keep that many iterates of each, so
         that a slider callback only looks them up. Grows both caches to hold them all.
         Shows a progress bar when the first step value predicts more than
         ``geomlib.numerics.progress.SECONDS`` in all."""
-        steps = [_check_step(s) for s in steps]
+        taus = [_check_tau(t) for t in taus]
         iterations = _check_iterations(iterations)
-        self.cache_size = max(self.cache_size, len(steps))
+        self.cache_size = max(self.cache_size, len(taus))
         if iterations:
-            self.history_size = max(self.history_size, len(steps))
-        bar = Iterations(len(steps), None, "factorising the step values")
+            self.history_size = max(self.history_size, len(taus))
+        bar = Iterations(len(taus), None, "factorising the step values")
         try:
-            for j, s in enumerate(steps, 1):
-                self.factor(s)
+            for j, tau in enumerate(taus, 1):
+                self.factor(tau)
                 if iterations:
-                    self.smooth(s, iterations, keep_volume=keep_volume, progress=False)
+                    self.smooth(tau, iterations, keep_volume=keep_volume, progress=False)
                 bar.step(j)
         finally:
             bar.close()
         return self
 
-    def step_once(self, P, step, factor=None):
-        """One implicit step from positions P (the fixed rows are taken from V)."""
-        factor = self.factor(step) if factor is None else factor
-        P_next = self.V.copy()
-        P_next[self.I] = factor.solve(self.m[self.I, None] * P[self.I] + step * self.CP_B)
-        return P_next
-
-    def smooth(self, step, iterations=1, keep_volume=False, progress=None, callback=None, P=None):
+    def smooth(self, tau, iterations=1, keep_volume=False, progress=None, callback=None, P=None):
         """Run ``iterations`` implicit steps from P (default: V); returns a new (n, 3) array.
 
         Without P and callback the iterates are kept (``history_size``) and a
         later call continues from the last one stored.
         """
-        step = _check_step(step)
+        tau = _check_tau(tau)
         iterations = _check_iterations(iterations)
         remember = P is None and callback is None and self.history_size > 0
         P = self.V.copy() if P is None else np.array(P, dtype=np.float64)
@@ -530,18 +478,19 @@ class ImplicitSmoother:
         keeper = _VolumeKeeper(P, self.F) if keep_volume else None
         history = []
         if remember:
-            history = self._history.pop((step, bool(keep_volume)), [])
-            self._history[(step, bool(keep_volume))] = history  # most recently used last
+            history = self._history.pop((tau, bool(keep_volume)), [])
+            self._history[(tau, bool(keep_volume))] = history  # most recently used last
             while len(self._history) > self.history_size:
                 self._history.pop(next(iter(self._history)))
             if len(history) >= iterations:
                 return history[iterations - 1].copy()
             P = history[-1] if history else P
-        start, factor = len(history), self.factor(step)
+        start, L = len(history), self.L
+        solve = L.step_solver(tau, self.factor(tau))
         bar = Iterations(iterations - start, progress, "implicit smoothing")
         try:
             for k in range(start + 1, iterations + 1):
-                P = self.step_once(P, step, factor)
+                P = implicit_step(P, L.M_step, L.C_step, tau, solve)
                 if keeper is not None:
                     try:
                         P = keeper(P, k)
@@ -557,23 +506,13 @@ class ImplicitSmoother:
         return P.copy() if remember else P
 
 
-def _volume_centroid(P, F):
-    """Signed enclosed volume and the centroid of the enclosed solid."""
-    a, b, c = P[F[:, 0]], P[F[:, 1]], P[F[:, 2]]
-    v = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0  # signed tetrahedra with the origin
-    vol = float(v.sum())
-    if vol == 0 or not np.isfinite(vol):
-        return vol, P.mean(axis=0)
-    return vol, (v[:, None] * (a + b + c)).sum(axis=0) / (4.0 * vol)
-
-
 class _Collapse(Exception):
     pass
 
 
 class _VolumeKeeper:
     """Rescale about the centroid so that the enclosed volume and its centroid stay
-    those of the start (Desbrun et al. 1999, section 5.3)."""
+    those of the start (the volume rescaling of Desbrun et al. 1999)."""
 
     def __init__(self, P, F):
         b = boundary_vertices(F, len(P))
@@ -583,7 +522,7 @@ class _VolumeKeeper:
                 f"is undefined); boundary vertices: {format_indices(b)}"
             )
         self.F = F
-        self.vol0, self.c0 = _volume_centroid(P, F)
+        self.vol0, self.c0 = volume_and_centroid(P, F)
         if not self.vol0 > 0:
             raise MeshError(
                 f"keep_volume: the enclosed volume is {self.vol0:.6g}, not positive "
@@ -591,60 +530,37 @@ class _VolumeKeeper:
             )
 
     def __call__(self, P, k):
-        vol, c = _volume_centroid(P, self.F)
+        vol, c = volume_and_centroid(P, self.F)
         if not (vol > 0 and np.isfinite(vol)):
             raise _Collapse(f"the enclosed volume became {vol:.6g} at iteration {k}")
         return self.c0 + (P - c) * (self.vol0 / vol) ** (1.0 / 3.0)
 
 
-def _cg_steps(smoother, step):
-    """A fixed-operator implicit step by Jacobi-preconditioned CG, warm-started from P."""
-    I = smoother.I
-    A = (sp.diags(smoother.m[I]) - step * smoother.C_II).tocsr()
-    jacobi = sp.diags(1.0 / A.diagonal())
-
-    def advance(P):
-        rhs = smoother.m[I, None] * P[I] + step * smoother.CP_B
-        P_next = smoother.V.copy()
-        for j in range(P.shape[1]):
-            x, info = sla.cg(A, rhs[:, j], x0=P[I, j], rtol=1e-10, atol=0.0, M=jacobi, maxiter=20 * len(I) + 100)
-            if info != 0:
-                raise MeshError(f"implicit smoothing: CG did not converge (info {info}); use solver='lu'")
-            P_next[I, j] = x
-        return P_next
-
-    return advance
-
-
-def _rebuilt_steps(F, weights, area, boundary, step):
-    """An implicit step with M and C rebuilt from the current positions (mean curvature flow)."""
-    count = [0]
-
-    def advance(P):
-        count[0] += 1
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", MeshWarning)
-            try:
-                smoother = ImplicitSmoother(P, F, weights, area, boundary, cache_size=1, history_size=0)
-                return smoother.step_once(P, step)
-            except (MeshWarning, MeshError) as exc:  # degenerate triangles, M - tau C singular
-                raise _Collapse(f"at iteration {count[0]}: {exc}") from None
-
-    return advance
+def _rebuilt_step(P, F, weights, area, boundary_condition, tau, k):
+    """One :func:`implicit_step` with M and C rebuilt from the current positions (mean curvature flow)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MeshWarning)
+        try:
+            L = LaplaceOperator(P, F, weights, area, boundary_condition)  # of P, so not kept in memory
+            L.require_positive_areas(F, "implicit_smoothing")
+            return implicit_step(P, L.M_step, L.C_step, tau, L.step_solver(tau))
+        except (MeshWarning, MeshError) as exc:  # degenerate triangles, M - tau C singular
+            raise _Collapse(f"at iteration {k}: {exc}") from None
 
 
 def implicit_smoothing(
     V,
     F,
-    step,
+    tau=None,
     iterations=1,
     weights="cotan",
     *,
+    step=None,
     area="barycentric",
-    boundary="fixed",
+    boundary_condition="fixed",
     rebuild=False,
     keep_volume=False,
-    solver="lu",
+    solver="cholesky",
     progress=None,
     callback=None,
     on_failure="raise",
@@ -654,38 +570,40 @@ def implicit_smoothing(
     Backward Euler on ``dP/dt = Delta P``, ``Delta = M^-1 C`` (C symmetric
     negative semidefinite), so ``M - tau C`` is symmetric positive definite
     for every ``tau >= 0`` and the scheme is stable for any step (Desbrun,
-    Meyer, Schroeder and Barr 1999).
+    Meyer, Schroeder and Barr 1999). Every iteration is one :func:`implicit_step`.
 
     Parameters
     ----------
     V : (n, 3) float64
         Vertex positions (not modified).
     F : (m, 3) int64
-    step : float >= 0
-        The step tau: length^2 for ``weights="cotan"``, dimensionless for
+    tau : float >= 0
+        The step: length^2 for ``weights="cotan"``, dimensionless for
         ``"uniform"``. Scale-free: ``tau / ell^2`` (mean edge length ell).
     iterations : int >= 0
     weights : "cotan" or "uniform"
+    step : float >= 0, optional
+        Another name for ``tau`` (the one DESIGN.md's contract uses).
     area : "barycentric" or "mixed"
-    boundary : "fixed" (default) or "free"
+    boundary_condition : "fixed" (default) or "free"
         Fixed: boundary vertices keep their positions and the interior block
         ``(M_II - tau C_II) P'_I = M_I P_I + tau C_IB P_B`` is solved.
     rebuild : bool
-        False (default): the operator of V is kept and factorised once
-        (:class:`ImplicitSmoother`). True: M and C are rebuilt from the current
-        positions every iteration (implicit mean curvature flow); as the
-        surface shrinks triangles degenerate and the mesh can collapse: then the
-        run stops (see ``on_failure``) instead of returning a NaN mesh.
+        False (default): the operator of V is kept and factorised once. True: M
+        and C are rebuilt from the current positions every iteration (implicit
+        mean curvature flow); as the surface shrinks triangles degenerate and
+        the mesh can collapse: then the run stops (see ``on_failure``) instead
+        of returning a NaN mesh.
     keep_volume : bool
         After every iteration rescale about the centroid of the enclosed solid
-        so that volume and centroid stay those of V (Desbrun et al. 1999,
-        section 5.3). Closed meshes only.
-    solver : "lu" or "cg"
-        For the fixed operator: "lu" a sparse Cholesky factorisation (the name
-        is kept from when this was an LU), exact to rounding; "cg" conjugate
-        gradients with a Jacobi preconditioner, warm-started, relative residual
-        1e-10 (fast on well-shaped meshes and small steps, slow on stretched
-        triangles and huge steps). The rebuilt operator always factorises.
+        so that volume and centroid stay those of V (the volume rescaling of
+        Desbrun et al. 1999). Closed meshes only.
+    solver : "cholesky" or "cg"
+        For the fixed operator: a sparse Cholesky factorisation, exact to
+        rounding; or conjugate gradients with a Jacobi preconditioner,
+        warm-started, relative residual 1e-10 (fast on well-shaped meshes and
+        small steps, slow on stretched triangles and huge steps). The rebuilt
+        operator always factorises.
     progress : None, True or False
         Progress bar (tqdm.auto); None: shown when the first iteration predicts
         more than ``geomlib.numerics.progress.SECONDS``.
@@ -705,34 +623,28 @@ def implicit_smoothing(
     Raises
     ------
     MeshError
-        Bad step, iterations or option; vertices with zero area; keep_volume
+        Bad tau, iterations or option; vertices with zero area; keep_volume
         on an open mesh; a failure (above) with ``on_failure="raise"``.
     """
     V, F = as_mesh(V, F)
-    step, iterations = _check_step(step), _check_iterations(iterations)
-    for value, name, choices in (
-        (weights, "weights", _WEIGHTS),
-        (boundary, "boundary", _BOUNDARY),
-        (solver, "solver", ("lu", "cg")),
-        (on_failure, "on_failure", _ON_FAILURE),
-    ):
-        _check_choice(value, name, choices)
+    tau, iterations = _check_tau(_tau_or_step(tau, step)), _check_iterations(iterations)
+    check_choice("solver", solver, SOLVERS)
+    check_choice("on_failure", on_failure, ON_FAILURE)
+    L = laplace_operator(V, F, weights, area, boundary_condition)
+    L.require_positive_areas(F, "implicit_smoothing")
     keeper = _VolumeKeeper(V, F) if keep_volume else None
-    if rebuild:
-        positive_vertex_areas(laplacian(V, F, weights=weights, area=area)[0], F, "implicit_smoothing")
-        advance = _rebuilt_steps(F, weights, area, boundary, step)
-    else:
-        smoother = ImplicitSmoother(V, F, weights, area, boundary, cache_size=1, history_size=0)
-        if iterations == 0 or step == 0:
-            return V.copy()
-        factor = smoother.factor(step) if solver == "lu" else None
-        advance = (lambda P: smoother.step_once(P, step, factor)) if factor else _cg_steps(smoother, step)
+    if not rebuild and (iterations == 0 or tau == 0):
+        return V.copy()
+    solve = None if rebuild else L.step_solver(tau, solver=solver)
     P, area0 = V.copy(), surface_area(V, F) if rebuild else None
     bar = Iterations(iterations, progress, "implicit smoothing")
     try:
         for k in range(1, iterations + 1):
             try:
-                P_next = advance(P)
+                if rebuild:
+                    P_next = _rebuilt_step(P, F, weights, area, boundary_condition, tau, k)
+                else:
+                    P_next = implicit_step(P, L.M_step, L.C_step, tau, solve)
                 if keeper is not None:
                     P_next = keeper(P_next, k)
             except _Collapse as exc:

@@ -21,8 +21,11 @@ __all__ = [
     "vertex_normals",
     "surface_area",
     "enclosed_volume",
+    "volume_and_centroid",
     "bounding_box_diagonal",
     "mean_edge_length",
+    "ROUNDING_RTOL",
+    "zero_below_rounding",
 ]
 
 
@@ -84,9 +87,11 @@ def vertex_normals(V, F):
     face of non-zero area has no normal: its row is (0, 0, 0), not NaN.
     """
     V, F = as_mesh(V, F)
-    N2 = face_cross(V, F)
-    N = np.stack([np.bincount(F.ravel(), np.repeat(N2[:, k], 3), minlength=len(V)) for k in range(3)], axis=1)
-    length = np.linalg.norm(N, axis=1, keepdims=True)
+    v0, v1, v2 = corner_positions(V, F)
+    N2 = cross(v1 - v0, v2 - v0)  # (3, m) coordinate rows of 2 A_f n_f
+    corners = F.T.ravel()  # corner by corner, matching np.tile of each row
+    N = np.stack([np.bincount(corners, np.tile(N2[k], 3), minlength=len(V)) for k in range(3)], axis=1)
+    length = np.sqrt(np.einsum("ij,ij->i", N, N))[:, None]
     return np.divide(N, length, out=np.zeros_like(N), where=length > 0)
 
 
@@ -101,9 +106,24 @@ def enclosed_volume(V, F):
     Positive for a closed mesh whose faces are counter-clockwise seen from
     outside; on an open mesh it depends on the origin (not checked here).
     """
+    return volume_and_centroid(V, F)[0]
+
+
+def volume_and_centroid(V, F):
+    """Signed enclosed volume (length^3) and the centroid (3,) of the enclosed solid.
+
+    Face f and the origin span a tetrahedron of signed volume
+    ``vol_f = v0 . (v1 x v2) / 6`` and centroid ``(v0 + v1 + v2) / 4``; the solid
+    is their signed sum. Where the volume is zero or not finite the centroid is
+    the mean of the vertices.
+    """
     V, F = as_mesh(V, F)
     v0, v1, v2 = corner_positions(V, F)
-    return float(np.einsum("cf,cf->", v0, cross(v1, v2)) / 6.0)
+    vol_f = np.einsum("cf,cf->f", v0, cross(v1, v2)) / 6.0
+    vol = float(vol_f.sum())
+    if vol == 0 or not np.isfinite(vol):
+        return vol, V.mean(axis=0)
+    return vol, (v0 + v1 + v2) @ vol_f / (4.0 * vol)
 
 
 def bounding_box_diagonal(V):
@@ -118,3 +138,26 @@ def mean_edge_length(V, F):
     F = as_faces(F, len(V))
     E = edges(F)
     return float(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1).mean())
+
+
+#: Relative size below which a value counts as zero to rounding. Rounding positions of size |x| leaves
+#: errors of a few 1e-16 |x| / ell in H ell, K ell^2 or a displacement / ell; 1e-9 is far above that and far
+#: below anything a mesh resolves (K ell^2 = 1e-9 is a sphere of radius 30 000 edges).
+ROUNDING_RTOL = 1e-9
+
+
+def zero_below_rounding(values, scale, rtol=ROUNDING_RTOL):
+    """``values`` with every entry of magnitude at most ``rtol * scale`` set to +0.0; NaN stays NaN.
+
+    Counts and signs of values that are zero to rounding must be zero: a flat mesh
+    has no vertex "with K < 0" and no H of "-0". ``scale`` is the quantity's own
+    size on the mesh, in its units: ``1 / ell`` for H, ``1 / ell**2`` for K, ``ell``
+    for a length (``ell = mean_edge_length(V, F)``).
+
+    Returns
+    -------
+    ndarray of float64, of the shape of ``values`` (a new array).
+    """
+    out = np.array(values, dtype=float)
+    out[np.abs(out) <= rtol * abs(float(scale))] = 0.0
+    return out

@@ -55,12 +55,17 @@ repeating a vertex (the faces and lines). Properties that do not stop a
 computation (zero-area faces, non-manifold parts, several components,
 unreferenced vertices, ...) are summarised in one :class:`~geomlib.MeshWarning`
 (see :func:`geomlib.mesh.report.check_mesh`); the mesh is returned unaltered.
+Nothing else reaches the screen: what trimesh logs while it reads a PLY or
+STL file for geomlib (tracebacks of what it recovers from) is dropped.
 """
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
 import re
+import threading
 import warnings
 from pathlib import Path
 
@@ -68,7 +73,7 @@ import numpy as np
 
 from .errors import MeshError, MeshWarning, count_text, format_indices
 from .report import check_mesh
-from .validate import as_mesh, as_vertices
+from .validate import as_mesh, as_vertices, repeated_vertex_faces
 
 __all__ = ["load_mesh", "save_mesh", "parse_obj", "SUPPORTED_EXTENSIONS"]
 
@@ -363,9 +368,8 @@ def _build_faces(where, n, idx, sizes, lines, one_based, vbefore=None):
         j = np.arange(int(ntri.sum())) - first_tri[tri_poly] + 1
         o = (np.cumsum(sizes) - sizes)[tri_poly]
         F = np.stack([res[o], res[o + j], res[o + j + 1]], axis=1)
-    rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-    if rep.any():
-        rows = np.flatnonzero(rep)
+    rows = repeated_vertex_faces(F)
+    if len(rows):
         plines = lines[rows if tri_poly is None else tri_poly[rows]]
         detail = "; ".join(f"line {L}: face {r} = {F[r].tolist()}" for r, L in zip(rows[:5], plines[:5]))
         tail = f"; faces {format_indices(rows)} on lines {format_indices(np.unique(plines))}" if len(rows) > 1 else ""
@@ -480,6 +484,47 @@ def _read_off(data, where):
 # PLY and STL through trimesh
 
 
+class _OtherThreads(logging.Filter):
+    """Passes the log records of every thread but the one that made it."""
+
+    def __init__(self):
+        super().__init__()
+        self.thread = threading.get_ident()
+
+    def filter(self, record):
+        return record.thread != self.thread
+
+
+@contextlib.contextmanager
+def _trimesh_quiet():
+    """Keep trimesh's log records and warnings off the reader's screen while geomlib calls it.
+
+    trimesh logs what it recovers from, with tracebacks ("failed to extract
+    face_normals" for an STL whose normals do not parse: geomlib does not use
+    them), and Python prints such records on stderr when nothing else handles
+    them. Around geomlib's own calls the result or the MeshError is the one
+    message. Only records from this thread are dropped, only while the call
+    runs: trimesh used directly, or from another thread, logs as configured.
+    """
+    import trimesh  # noqa: F401  (its modules' loggers exist once it is imported)
+
+    loggers = [
+        logger
+        for name, logger in list(logging.Logger.manager.loggerDict.items())
+        if (name == "trimesh" or name.startswith("trimesh.")) and isinstance(logger, logging.Logger)
+    ]
+    only_others = _OtherThreads()
+    for logger in loggers:
+        logger.addFilter(only_others)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        for logger in loggers:
+            logger.removeFilter(only_others)
+
+
 def _read_trimesh(path, where, ext, data):
     import trimesh
 
@@ -487,8 +532,7 @@ def _read_trimesh(path, where, ext, data):
         raise MeshError(f"{where}: not a PLY file: it does not start with the line 'ply'")
 
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+        with _trimesh_quiet():
             loaded = trimesh.load(str(path), file_type=ext[1:], process=False, maintain_order=True)
     except Exception as exc:  # any parser failure becomes a MeshError naming the file
         raise MeshError(f"{where}: cannot read as {ext[1:].upper()}: {type(exc).__name__}: {exc}") from None
@@ -665,8 +709,11 @@ def save_mesh(path, V, F):
         else:
             import trimesh
 
-            mesh = trimesh.Trimesh(vertices=V, faces=F, process=False, validate=False)
+            with _trimesh_quiet():
+                stl = trimesh.exchange.stl.export_stl(
+                    trimesh.Trimesh(vertices=V, faces=F, process=False, validate=False)
+                )
             with open(where, "wb") as fh:
-                fh.write(trimesh.exchange.stl.export_stl(mesh))
+                fh.write(stl)
     except OSError as exc:
         raise MeshError(f"{where}: cannot write the file: {exc.strerror or exc}") from None

@@ -8,8 +8,10 @@
   faces that repeat a vertex. The message names the problem and the offending
   vertex or face indices. They cost O(n + m) vectorised work and never copy
   arrays that already have the right dtype and layout.
-* :func:`is_zero_area` is the package's one test for a zero-area triangle and
-  :func:`zero_area_faces` lists them.
+* :func:`is_zero_area` is the package's one test for a zero-area triangle
+  (:func:`geomlib.mesh.geometry.zero_area_faces` lists them).
+* :func:`check_choice` is the package's one check of an option that takes one
+  of a few named values (``weights=``, ``area=``, ``scheme=``, ...).
 
 The report of mesh properties that do not stop a computation (boundaries,
 non-manifold parts, components, ...) is :func:`geomlib.mesh.report.check_mesh`.
@@ -21,7 +23,15 @@ import numpy as np
 
 from .errors import MeshError, count_text, format_indices
 
-__all__ = ["as_mesh", "as_faces", "as_vertices", "is_zero_area", "ZERO_AREA_RTOL"]
+__all__ = [
+    "as_mesh",
+    "as_faces",
+    "as_vertices",
+    "repeated_vertex_faces",
+    "is_zero_area",
+    "check_choice",
+    "ZERO_AREA_RTOL",
+]
 
 # A face counts as zero-area when twice its area is at most this fraction of
 # its longest edge squared, i.e. its height over the longest edge is below
@@ -58,7 +68,7 @@ def _as_int_array(F, label, where):
     raise MeshError(f"{_prefix(where)}{label} has dtype {F.dtype}; face indices must be integers")
 
 
-def as_faces(F, n=None, *, where=None, allow_empty=False):
+def as_faces(F, n=None, *, where=None, allow_empty=False, allow_repeated=False):
     """Validate a face array: (m, 3) int64, C-contiguous, 0-based.
 
     Parameters
@@ -73,6 +83,9 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
         Prefix for error messages (a file name, an argument name).
     allow_empty : bool
         Accept ``m = 0``.
+    allow_repeated : bool
+        Accept faces that repeat a vertex (for a drawing, where such a face is
+        simply invisible; every computation refuses them).
 
     Returns
     -------
@@ -83,7 +96,8 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
     ------
     MeshError
         Wrong shape or dtype; indices out of range (the faces, the bad index
-        and the vertex count are named); faces that repeat a vertex.
+        and the vertex count are named); faces that repeat a vertex (unless
+        ``allow_repeated``).
     """
     F = _as_int_array(F, "F", where)
     if F.ndim != 2 or F.shape[1] != 3:
@@ -102,15 +116,19 @@ def as_faces(F, n=None, *, where=None, allow_empty=False):
         raise MeshError(
             f"{_prefix(where)}face indices out of range (valid: {valid}): {detail}{more}; faces {format_indices(rows)}"
         )
-    rep = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0])
-    if rep.any():
-        rows = np.flatnonzero(rep)
+    rows = [] if allow_repeated else repeated_vertex_faces(F)
+    if len(rows):
         detail = ", ".join(f"face {r} = {F[r].tolist()}" for r in rows[:5])
         raise MeshError(
             f"{_prefix(where)}{count_text(rows, 'face repeats', 'faces repeat')} a vertex (no triangle): {detail}; "
             f"faces {format_indices(rows)}"
         )
     return F
+
+
+def repeated_vertex_faces(F):
+    """Indices (k,) int64 of the faces that repeat a vertex (no triangle); ``F`` an (m, 3) integer array."""
+    return np.flatnonzero((F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 2] == F[:, 0]))
 
 
 def as_vertices(V, *, where=None):
@@ -187,3 +205,15 @@ def is_zero_area(dblA, longest2, rtol=ZERO_AREA_RTOL):
     squared (arrays of the same shape); returns a boolean array.
     """
     return dblA <= rtol * longest2
+
+
+def check_choice(name, value, choices):
+    """Return ``value`` if it is one of ``choices``; otherwise raise MeshError naming the option, the value and the choices.
+
+    >>> check_choice("weights", "cotan", ("cotan", "uniform"))
+    'cotan'
+    """
+    if isinstance(value, str) and value in choices:  # `in` on a non-string (an array) would compare elementwise
+        return value
+    listed = ", ".join(repr(c) for c in choices)
+    raise MeshError(f"{name} must be one of {listed}, not {value!r}")

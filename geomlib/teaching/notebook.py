@@ -40,7 +40,17 @@ from ..mesh.repair import largest_component, remove_unreferenced_vertices, remov
 from ..mesh.topology import boundary_vertices, connected_components
 from ..mesh.validate import as_mesh
 
-__all__ = ["show_source", "explain", "claim", "note", "prepare", "ClaimFailed", "strict_claims", "NOTE_PREFIX"]
+__all__ = [
+    "show_source",
+    "explain",
+    "claim",
+    "note",
+    "prepare",
+    "ClaimFailed",
+    "strict_claims",
+    "graded",
+    "NOTE_PREFIX",
+]
 
 #: first word of the text/plain form of every note (the input tests look for it)
 NOTE_PREFIX = "Note:"
@@ -55,6 +65,12 @@ class ClaimFailed(AssertionError):
 def strict_claims():
     """True when failed claims must raise (the test suite's default runs)."""
     return os.environ.get("GEOMLIB_STRICT_CLAIMS", "0") == "1"
+
+
+def graded():
+    """True while nbgrader runs the notebook (``nbgrader autograde`` and ``validate`` set
+    ``NBGRADER_EXECUTION`` in the kernel): exercise checks then raise, views give stills."""
+    return bool(os.environ.get("NBGRADER_EXECUTION"))
 
 
 def _display(bundle):

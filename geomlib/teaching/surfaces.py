@@ -36,7 +36,7 @@ values against closed forms derived independently.
 Functions: :func:`plane`, :func:`saddle`, :func:`sphere` (icosphere),
 :func:`uv_sphere`, :func:`ellipsoid` (mapped icosphere), :func:`uv_ellipsoid`,
 :func:`torus`, and :func:`attach_truth` for vertices read from a file (for
-instance ``meshes/ellipsoid.obj``).
+instance ``geomlib/meshes/ellipsoid.obj``).
 """
 
 from __future__ import annotations
@@ -49,7 +49,8 @@ from typing import Callable, Mapping
 import numpy as np
 
 from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import face_cross
+from ..mesh.geometry import face_cross, zero_area_faces
+from ..mesh.validate import check_choice
 
 __all__ = [
     "AnalyticMesh",
@@ -63,6 +64,7 @@ __all__ = [
     "torus",
     "attach_truth",
     "icosphere",
+    "grid_faces",
 ]
 
 
@@ -231,19 +233,16 @@ def _check_faces(V, F, D, what):
     three vertices; this happens only when the jitter folds the tessellation
     over, and is reported rather than repaired.
     """
-    FN = face_cross(V, F)
-    A2 = np.linalg.norm(FN, axis=1)
-    scale = np.mean(np.linalg.norm(V[F[:, 1]] - V[F[:, 0]], axis=1)) ** 2
-    bad = np.flatnonzero(A2 <= 1e-12 * scale)
+    bad = zero_area_faces(V, F)
     if bad.size:
         raise MeshError(f"{what}: zero-area faces {format_indices(bad)}")
-    s = np.einsum("ij,ij->i", FN, D[F].sum(axis=1))
+    s = np.einsum("ij,ij->i", face_cross(V, F), D[F].sum(axis=1))
     bad = np.flatnonzero(s <= 0)
     if bad.size:
         raise MeshError(f"{what}: inverted faces {format_indices(bad)} (jitter too large for this resolution)")
 
 
-def _grid_faces(nu, nv, periodic_u=False, periodic_v=False, diagonals="right"):
+def grid_faces(nu, nv, periodic_u=False, periodic_v=False, diagonals="right"):
     """Triangles of an nu x nv vertex grid, vertex index i * nv + j.
 
     Each quad (i, j), (i+1, j), (i+1, j+1), (i, j+1) is counter-clockwise when
@@ -261,12 +260,8 @@ def _grid_faces(nu, nv, periodic_u=False, periodic_v=False, diagonals="right"):
     b = I1 * nv + J
     c = I1 * nv + J1
     d = I * nv + J1
-    if diagonals == "right":
-        flip = np.zeros(a.shape, dtype=bool)
-    elif diagonals == "alternate":
-        flip = (I + J) % 2 == 1
-    else:
-        raise MeshError(f"diagonals must be 'right' or 'alternate', got {diagonals!r}")
+    check_choice("diagonals", diagonals, ("right", "alternate"))
+    flip = (I + J) % 2 == 1 if diagonals == "alternate" else np.zeros(a.shape, dtype=bool)
     t1 = np.where(flip[:, None], np.stack([a, b, d], 1), np.stack([a, b, c], 1))
     t2 = np.where(flip[:, None], np.stack([b, c, d], 1), np.stack([a, c, d], 1))
     F = np.empty((2 * a.size, 3), dtype=np.int64)
@@ -428,7 +423,7 @@ def plane(n=20, size=2.0, jitter=0.0, seed=0, diagonals="right"):
     jitter = _jitter(jitter)
     x, y = _square_grid(n, size, jitter, seed)
     V = np.stack([x, y, np.zeros_like(x)], axis=1)
-    F = _grid_faces(n + 1, n + 1, diagonals=diagonals)
+    F = grid_faces(n + 1, n + 1, diagonals=diagonals)
     up = np.array([0.0, 0.0, 1.0])
     _check_faces(V, F, np.broadcast_to(up, V.shape), "plane")
     params = dict(n=n, size=size, jitter=jitter, seed=seed, diagonals=diagonals)
@@ -490,7 +485,7 @@ def saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.0, seed=0, diagon
     jitter = _jitter(jitter)
     x, y = _square_grid(n, size, jitter, seed)
     V = np.stack([x, y, saddle_height(x, y, A, B)], axis=1)
-    F = _grid_faces(n + 1, n + 1, diagonals=diagonals)
+    F = grid_faces(n + 1, n + 1, diagonals=diagonals)
     # upward side: +z (the tessellation must not fold over in the (x, y) plane)
     _check_faces(V, F, np.broadcast_to([0.0, 0.0, 1.0], V.shape), "saddle")
     params = dict(n=n, size=size, amplitude=A, monkey=B, jitter=jitter, seed=seed, diagonals=diagonals)
@@ -734,7 +729,7 @@ def _uv_ellipsoid_mesh(a, b, c, n, jitter, seed):
     # body: quads between consecutive rings; grid faces in (i, j) with i periodic
     body = np.empty((0, 3), dtype=np.int64)
     if rings >= 2:
-        body = _grid_faces(nu, rings, periodic_u=True) + 1
+        body = grid_faces(nu, rings, periodic_u=True) + 1
     i = np.arange(nu)
     i1 = (i + 1) % nu
     north = np.stack([np.zeros(nu, dtype=np.int64), i * rings + 1, i1 * rings + 1], axis=1)
@@ -843,7 +838,7 @@ def torus(R=1.0, r=0.4, n=64, m=None, jitter=0.0, seed=0):
         u = u + du * ou
         v = v + dv * ov
     V = _torus_point(u, v, R, r)
-    F = _grid_faces(n, m, periodic_u=True, periodic_v=True)
+    F = grid_faces(n, m, periodic_u=True, periodic_v=True)
     # outside: away from the tube's centre circle
     _check_faces(V, F, V - _torus_point(u, np.full_like(v, np.pi / 2), R, 0.0), "torus")
     params = dict(R=R, r=r, n=n, m=m, jitter=jitter, seed=seed)
@@ -872,7 +867,7 @@ def attach_truth(name, V, F, **params):
     Convention as :class:`AnalyticMesh` (outward / upward ``N``, H > 0 on a
     sphere). Use it for meshes read from a file, e.g.
     ``attach_truth("ellipsoid", V, F, a=1.0, b=0.7, c=0.5)`` for
-    ``meshes/ellipsoid.obj``. The truth is evaluated at the parameters of the
+    ``geomlib/meshes/ellipsoid.obj``. The truth is evaluated at the parameters of the
     nearest exact point: the vertices are projected to the surface for the
     evaluation (a file stores about 9 significant digits), while ``V`` is
     returned as given.

@@ -12,11 +12,13 @@ import warnings
 
 import numpy as np
 
+from ..lessons.laplace import WEIGHTS
 from ..lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
 from ..lessons.noise import add_noise
 from ..lessons.smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit
 from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.geometry import mean_edge_length
+from ..mesh.validate import check_choice
+from .steps import absolute_step
 
 __all__ = [
     "SCHEMES",
@@ -29,6 +31,9 @@ __all__ = [
     "SmoothingSweep",
     "smoothing_sweep",
 ]
+
+#: The smoothing methods a scheme can name.
+METHODS = ("explicit", "implicit")
 
 #: (method, weights) pairs compared by :func:`smoothing_sweep`.
 SCHEMES = (("explicit", "uniform"), ("explicit", "cotan"), ("implicit", "uniform"), ("implicit", "cotan"))
@@ -63,15 +68,11 @@ def scale_free_step(V, F, method, weights, value):
     (noise makes obtuse triangles with large cotangents), which is why the
     implicit step is not tied to it.
     """
+    check_choice("method", method, METHODS)
+    check_choice("weights", weights, WEIGHTS)
     if method == "explicit":
         return float(value) * explicit_step_limit(V, F, weights)
-    if method != "implicit":
-        raise MeshError(f"method must be 'explicit' or 'implicit', not {method!r}")
-    if weights == "uniform":
-        return float(value)
-    if weights == "cotan":
-        return float(value) * mean_edge_length(V, F) ** 2 / 4.0
-    raise MeshError(f"weights must be 'cotan' or 'uniform', not {weights!r}")
+    return absolute_step(value / 4.0 if weights == "cotan" else value, "ell^2", V, F, weights)
 
 
 class SmoothingSweep:
@@ -204,11 +205,8 @@ def smoothing_sweep(
         raise MeshError("iterations must be positive whole numbers")
     step_values = {"explicit": tuple(explicit_fractions), "implicit": tuple(implicit_steps)}
     for method, weights in schemes:
-        if method not in step_values or weights not in ("uniform", "cotan"):
-            raise MeshError(
-                f"unknown scheme ({method!r}, {weights!r}); methods are 'explicit' and "
-                "'implicit', weights 'uniform' and 'cotan'"
-            )
+        check_choice("method", method, METHODS)
+        check_choice("weights", weights, WEIGHTS)
     out = SmoothingSweep(sigmas, schemes, step_values, iterations)
     where = {int(k): l for l, k in enumerate(iterations)}
     last = int(iterations[-1])

@@ -1,4 +1,8 @@
-"""Interactive 3D mesh views for the notebooks (pythreejs 2.4 / three.js r97).
+"""Interactive 3D mesh views for the notebooks (pythreejs 2.4 / three.js r97): the widget.
+
+The view's colours come from :mod:`.colours` (colour maps, colour bars) and its
+still picture from :mod:`.stills` (a numpy rasteriser); sliders, read-outs,
+arrows and markers are wired by :mod:`.controls`.
 
 Convention: a view shows ``V`` (n, 3) float64 and ``F`` (m, 3) int64 as a
 smooth-shaded surface, optionally coloured by a per-vertex scalar ``values``
@@ -30,7 +34,8 @@ if there is none, the first slider displayed by the same cell as a view
 cell change. So a notebook needs at least one slider next to a view in one of
 these two ways, and that slider must change the picture whether it is moved to
 its maximum (or to its minimum when it starts there). Sliders elsewhere are
-not moved by the test. Views shown with ``side_by_side`` are also checked for
+not moved by the test (``geomlib.teaching.controls.live`` puts its controls and views in one
+box). Views shown with ``side_by_side`` are also checked for
 linked cameras (an orbit drag in the first view must turn the second).
 
 Many views on one page
@@ -45,8 +50,8 @@ Updates
 ``view.update(V=..., values=...)`` overwrites the buffers in place: positions,
 normals and colours live in one interleaved float32 buffer, so an update is a
 single widget message and the browser never shows a half-updated frame.
-Normals are area-weighted face normals summed at the vertices by one sparse
-matrix product (prepared once per view). The colour bar's text is a second,
+Normals are :func:`geomlib.mesh.geometry.vertex_normals` (through
+:func:`.stills.view_normals`, which gives a vertex without a normal (0, 0, 1)). The colour bar's text is a second,
 small message and is only sent when the printed range changes (pass fixed
 ``vmin``/``vmax`` for sliders to avoid it).
 
@@ -89,42 +94,54 @@ state it embeds the live widget, which needs the widget scripts from a CDN.)
 A view shown inside an ipywidgets box (``VBox([slider, view.widget])``) is
 drawn too: importing this module in IPython gives every box holding views a
 still picture of them (``box_still``), side by side.
+
+While nbgrader runs a notebook (``autograde``, ``validate``) a view gives its
+still picture and summary only, without the widget (``stills_only``), and other
+widgets their text: the feedback pages are static HTML without widget
+state, where a widget would be an empty placeholder.
 """
 
-import base64
 import html
-import io
 import weakref
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..mesh.errors import MeshError, format_indices
+from ..mesh.geometry import enclosed_volume
+from ..mesh.topology import Topology, edges
+from ..mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
+from .colours import (
+    NAN_COLOR,
+    PLAIN_COLOR,
+    ZERO_COLOR,
+    ZERO_TOL,
+    colorbar_html,
+    colorize,
+    colour_table,
+    format_value,
+    value_range,
+    zero_html,
+)
+from .notebook import graded
+from .stills import (
+    FOV,
+    UP,
+    VIEWS,
+    bounding_frame,
+    camera_basis,
+    camera_distance,
+    in_a_row,
+    png_base64,
+    render_still,
+    still_with_colorbar,
+    view_normals,
+)
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "colorize", "vertex_normals_fast", "render_still", "box_still"]
+__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "stills_only"]
 
-#: colour of vertices whose value is NaN (RGB in [0, 1])
-NAN_COLOR = (0.62, 0.62, 0.62)
-#: colour of a field that is zero up to rounding (white: nothing to see)
-ZERO_COLOR = (1.0, 1.0, 1.0)
-#: default ``zero_tol``: a field whose finite values all satisfy |v| <= ZERO_TOL
-#: (in its own units) is zero up to rounding and drawn in ZERO_COLOR
-ZERO_TOL = 1e-10
 #: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
 #: of the largest one is drawn enlarged to the largest one's size
 SPECK_RATIO = 0.25
-#: colour of a surface without values
-PLAIN_COLOR = (0.74, 0.78, 0.86)
-#: the axis drawn upwards -> (up vector, viewing direction from the bounding-box
-#: centre towards the eye): from the front, a little from the right and above
-VIEWS = {
-    "z": ((0.0, 0.0, 1.0), (0.55, -1.0, 0.5)),
-    "y": ((0.0, 1.0, 0.0), (0.55, 0.5, 1.0)),
-    "x": ((1.0, 0.0, 0.0), (0.5, 0.55, 1.0)),
-}
-UP, VIEW_DIRECTION = VIEWS["z"]
-#: vertical field of view of the camera in degrees
-FOV = 30.0
 #: multisampled (smooth) edges: True, False, or "auto" = only for meshes of at
 #: most ANTIALIAS_MAX_VERTICES vertices. Without a GPU (software WebGL) the
 #: multisampling costs noticeable time per frame on large meshes, whose small
@@ -166,38 +183,13 @@ void main() {
 # ----------------------------------------------------------------------------
 
 
-def _check_vertices(V, n=None, name="V"):
-    try:
-        V = np.asarray(V, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise MeshError(f"{name} must be an (n, 3) array of numbers: {exc}") from None
-    if V.ndim != 2 or V.shape[1] != 3:
-        raise MeshError(f"{name} must have shape (n, 3); got {V.shape}")
-    if n is not None and V.shape[0] != n:
+def _check_count(V, n):
+    if len(V) != n:
         raise MeshError(
-            f"{name} has {V.shape[0]} vertices; the view was built with {n} "
+            f"V has {len(V)} vertices; the view was built with {n} "
             "(the vertex count cannot change in update; make a new MeshView)"
         )
-    bad = np.flatnonzero(~np.isfinite(V).all(axis=1))
-    if bad.size:
-        raise MeshError(f"{name} has non-finite coordinates at vertices {format_indices(bad)}")
     return V
-
-
-def _check_faces(F, n):
-    F = np.asarray(F)
-    if F.ndim != 2 or F.shape[1] != 3:
-        raise MeshError(f"F must have shape (m, 3) (triangles); got {F.shape}")
-    if F.shape[0] == 0:
-        raise MeshError("F has no faces; a view needs at least one triangle")
-    if not np.issubdtype(F.dtype, np.integer):
-        if not np.issubdtype(F.dtype, np.floating) or not np.all(np.mod(F, 1) == 0):
-            raise MeshError(f"F must hold integer vertex indices; got dtype {F.dtype}")
-    F = F.astype(np.int64)
-    bad = np.flatnonzero(((F < 0) | (F >= n)).any(axis=1))
-    if bad.size:
-        raise MeshError(f"F refers to vertices outside 0..{n - 1} in faces {format_indices(bad)}")
-    return F
 
 
 def _check_values(values, n):
@@ -216,173 +208,22 @@ def _check_values(values, n):
 
 
 # ----------------------------------------------------------------------------
-# colour mapping and normals (pure functions, vectorised)
-# ----------------------------------------------------------------------------
-
-
-def _get_cmap(cmap):
-    import matplotlib
-
-    try:
-        return matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
-    except KeyError:
-        raise MeshError(f"unknown matplotlib colour map {cmap!r}") from None
-
-
-def _lut(cmap, size=256):
-    cm = _get_cmap(cmap)
-    return cm(np.linspace(0.0, 1.0, size))[:, :3].astype(np.float32)
-
-
-def value_range(values, symmetric=False, vmin=None, vmax=None):
-    """Colour range ``(vmin, vmax)`` for ``values``: the finite min and max, or
-    ``(-a, a)`` with ``a = max |values|`` when ``symmetric``; given bounds are
-    kept. A range of zero width is widened slightly so the colours stay defined
-    (all values then get the middle colour)."""
-    finite = values[np.isfinite(values)] if values is not None else np.zeros(0)
-    if symmetric:
-        if vmin is not None or vmax is not None:
-            a = max(abs(vmin or 0.0), abs(vmax or 0.0))
-        else:
-            a = float(np.abs(finite).max()) if finite.size else 1.0
-        lo, hi = -a, a
-    else:
-        lo = float(finite.min()) if vmin is None and finite.size else (0.0 if vmin is None else float(vmin))
-        hi = float(finite.max()) if vmax is None and finite.size else (1.0 if vmax is None else float(vmax))
-    if not hi > lo:
-        eps = max(abs(lo), abs(hi), 1.0) * 1e-9
-        lo, hi = lo - eps, hi + eps
-    return lo, hi
-
-
-def colorize(values, cmap="viridis", vmin=0.0, vmax=1.0, lut=None):
-    """Per-vertex RGB colours in [0, 1]: ``cmap((values - vmin) / (vmax - vmin))``.
-
-    Parameters
-    ----------
-    values : (n,) float64; NaN entries get :data:`NAN_COLOR`.
-    cmap : matplotlib colour map name (or object); ignored when ``lut`` is given.
-    vmin, vmax : the values mapped to the ends of the map (clipped beyond).
-    lut : optional (k, 3) float32 table of the map sampled at k points.
-
-    Returns
-    -------
-    (n, 3) float32
-    """
-    values = np.asarray(values, dtype=np.float64)
-    if lut is None:
-        lut = _lut(cmap)
-    k = lut.shape[0]
-    with np.errstate(invalid="ignore"):
-        t = (values - vmin) * ((k - 1) / (vmax - vmin)) + 0.5
-    nan = np.isnan(t)
-    idx = np.clip(np.where(nan, 0.0, t), 0, k - 1).astype(np.intp)
-    colors = lut[idx]
-    if nan.any():
-        colors[nan] = NAN_COLOR
-    return colors
-
-
-def _corner_matrix(F, n):
-    """Sparse (n, m) 0/1 matrix S with S[i, f] = 1 when vertex i is a corner of f."""
-    m = F.shape[0]
-    rows = F.ravel()
-    cols = np.repeat(np.arange(m), 3)
-    return sp.csr_matrix((np.ones(3 * m, dtype=np.float64), (rows, cols)), shape=(n, m))
-
-
-def _face_normal_sums(P, Fc, S):
-    """S @ (face cross products), coordinate by coordinate (gathers of 1-D arrays are fast)."""
-    x, y, z = (np.ascontiguousarray(P[:, c]) for c in range(3))
-    i, j, k = Fc
-    ax, ay, az = x[j] - x[i], y[j] - y[i], z[j] - z[i]
-    bx, by, bz = x[k] - x[i], y[k] - y[i], z[k] - z[i]
-    Nf = np.empty((len(i), 3), dtype=P.dtype)
-    Nf[:, 0] = ay * bz - az * by
-    Nf[:, 1] = az * bx - ax * bz
-    Nf[:, 2] = ax * by - ay * bx
-    return S @ Nf
-
-
-def _normalise(N):
-    length = np.sqrt(np.einsum("ij,ij->i", N, N))
-    zero = length == 0
-    length[zero] = 1.0
-    N /= length[:, None]
-    if zero.any():
-        N[zero] = (0.0, 0.0, 1.0)
-    return N
-
-
-def vertex_normals_fast(V, F, S=None):
-    """Unit vertex normals: the area-weighted sum of the incident face normals.
-
-    Face normals are ``(v1 - v0) x (v2 - v0)`` (twice the area times the unit
-    normal, outward for counter-clockwise faces); their sum at each vertex is
-    one sparse product ``S @ N_f`` with the corner matrix ``S`` (pass it to
-    reuse it). Vertices in no face get the normal (0, 0, 1).
-
-    Returns
-    -------
-    (n, 3) float64
-    """
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F)
-    if S is None:
-        S = _corner_matrix(F, V.shape[0])
-    Fc = [np.ascontiguousarray(F[:, c]) for c in range(3)]
-    return _normalise(_face_normal_sums(V, Fc, S))
-
-
-# ----------------------------------------------------------------------------
-# camera and the still picture
+# camera orientation of the live view
 # ----------------------------------------------------------------------------
 
 
 def _closed_outward(V, F):
-    """True when every directed edge (i, j) has its reverse (j, i): a closed,
-    consistently oriented mesh, and its enclosed volume is positive (faces
-    counter-clockwise from outside). Then back faces can never be seen from
-    outside and the renderer may skip them."""
-    n = np.int64(V.shape[0])
-    i, j = F.ravel(), F[:, [1, 2, 0]].ravel()
-    key = np.sort(i * n + j)
-    if key.size > 1 and (key[1:] == key[:-1]).any():
-        return False  # an edge used twice in the same direction
-    reverse = np.sort(j * n + i)
-    if not np.array_equal(key, reverse):
-        return False  # a boundary, or orientation flips somewhere
-    p0, p1, p2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    return float(np.einsum("ij,ij->", p0, np.cross(p1, p2))) > 0
-
-
-def _frame(V):
-    """Bounding-box centre and half diagonal of V."""
-    lo, hi = V.min(axis=0), V.max(axis=0)
-    centre = 0.5 * (lo + hi)
-    radius = 0.5 * float(np.linalg.norm(hi - lo))
-    return centre, (radius if radius > 0 else 1.0)
-
-
-def _camera_distance(radius, width, height, fov=FOV):
-    half_v = np.radians(fov) / 2
-    half_h = np.arctan(np.tan(half_v) * width / height)
-    return 0.95 * radius / np.sin(min(half_v, half_h))
-
-
-def _basis(direction, up=UP):
-    w = np.asarray(direction, dtype=np.float64)
-    w = w / np.linalg.norm(w)
-    right = np.cross(up, w)
-    if np.linalg.norm(right) < 1e-9:
-        right = np.cross(np.roll(up, 1), w)
-    right /= np.linalg.norm(right)
-    return right, np.cross(w, right), w
+    """True when every edge has two faces traversing it in opposite directions (a closed,
+    consistently oriented mesh) and the enclosed volume is positive (faces counter-clockwise
+    from outside). Then back faces can never be seen from outside and the renderer may skip them."""
+    T = Topology(F, len(V))
+    closed = (T.edge_face_count == 2).all() and len(T.inconsistent_edges()) == 0
+    return bool(closed) and enclosed_volume(V, F) > 0
 
 
 def _look_at_quaternion(direction, up=UP):
     """Quaternion (x, y, z, w) of a camera at ``direction`` looking at the origin, ``up`` up."""
-    right, up, w = _basis(direction, up)
+    right, up, w = camera_basis(direction, up)
     R = np.column_stack([right, up, w])  # camera looks along -w
     tr = np.trace(R)
     if tr > 0:
@@ -397,188 +238,6 @@ def _look_at_quaternion(direction, up=UP):
         q[j] = (R[j, i] + R[i, j]) / s
         q[k] = (R[k, i] + R[i, k]) / s
     return tuple(float(x) for x in q)
-
-
-def render_still(
-    V,
-    F,
-    colors,
-    normals=None,
-    width=420,
-    height=340,
-    direction=VIEW_DIRECTION,
-    up=UP,
-    distance=None,
-    fov=FOV,
-    background=(1.0, 1.0, 1.0),
-    centre=None,
-):
-    """Draw the mesh as the viewer's camera first sees it, into an RGB image.
-
-    The camera looks at ``centre`` (default: the centre of V's bounding box)
-    from ``distance`` (default: framing V's bounding box).
-
-    A z-buffer rasteriser in numpy: vertices are projected with the camera of
-    the 3D view, shaded by the same head light (|n . e|, both sides lit), and
-    every triangle's pixel centres are found from its bounding box with
-    barycentric coordinates; the nearest candidate per pixel wins
-    (depth tested with interpolated 1/z). Colours are interpolated (Gouraud).
-
-    Returns
-    -------
-    (height, width, 3) uint8
-    """
-    V = np.asarray(V, dtype=np.float64)
-    own_centre, radius = _frame(V)
-    centre = own_centre if centre is None else np.asarray(centre, dtype=np.float64)
-    if distance is None:
-        distance = _camera_distance(radius, width, height, fov)
-    right, up, w = _basis(direction, up)
-    P = V - centre
-    eye = w * distance
-    depth = distance - P @ w  # distance along the viewing axis
-    depth = np.maximum(depth, 1e-6 * distance)
-    f = (height / 2) / np.tan(np.radians(fov) / 2)
-    sx = width / 2 + f * (P @ right) / depth
-    sy = height / 2 - f * (P @ up) / depth
-    if normals is None:
-        normals = vertex_normals_fast(V, F)
-    to_eye = eye - P
-    to_eye /= np.linalg.norm(to_eye, axis=1, keepdims=True)
-    d = np.abs(np.einsum("ij,ij->i", normals, to_eye))
-    shade = 0.35 + 0.65 * d
-    vc = np.asarray(colors, dtype=np.float64)[:, :3] * shade[:, None] + 0.12 * (d**40)[:, None]
-    inv = 1.0 / depth
-
-    X, Y = sx[F], sy[F]  # (m, 3) screen corners
-    x0 = np.floor(X.min(axis=1) - 0.5).astype(np.int64)
-    y0 = np.floor(Y.min(axis=1) - 0.5).astype(np.int64)
-    x1 = np.floor(X.max(axis=1) - 0.5).astype(np.int64) + 1
-    y1 = np.floor(Y.max(axis=1) - 0.5).astype(np.int64) + 1
-    area = (X[:, 1] - X[:, 0]) * (Y[:, 2] - Y[:, 0]) - (X[:, 2] - X[:, 0]) * (Y[:, 1] - Y[:, 0])
-    visible = (x1 >= 0) & (y1 >= 0) & (x0 < width) & (y0 < height) & (np.abs(area) > 1e-12)
-    # pixel boxes clipped to the image, and grouped by their width and height rounded up to powers of
-    # two: a long sliver (a spike of an unstable run) is tested on its own box, not on a square around it
-    x0, y0 = np.maximum(x0, 0), np.maximum(y0, 0)
-    x1, y1 = np.minimum(x1, width - 1), np.minimum(y1, height - 1)
-    log_w = np.ceil(np.log2(np.maximum(x1 - x0 + 1, 1))).astype(np.int64)
-    log_h = np.ceil(np.log2(np.maximum(y1 - y0 + 1, 1))).astype(np.int64)
-    size = 64 * log_w + log_h  # one integer per box size 2^log_w x 2^log_h (unique on rows sorts 10x slower)
-    pix_all, key_all, col_all = [], [], []
-    vis = np.flatnonzero(visible)
-    for code in np.unique(size[vis]):
-        ids = vis[size[vis] == code]
-        sw, sh = 2 ** (code // 64), 2 ** (code % 64)
-        ox, oy = np.meshgrid(np.arange(sw), np.arange(sh))
-        ox, oy = ox.ravel(), oy.ravel()
-        chunk = max(1, 2_000_000 // int(sw * sh))
-        for start in range(0, ids.size, chunk):
-            fi = ids[start : start + chunk]
-            px = x0[fi, None] + ox[None, :]
-            py = y0[fi, None] + oy[None, :]
-            cx, cy = px + 0.5, py + 0.5
-            Xf, Yf = X[fi], Y[fi]
-            a = area[fi, None]
-            b0 = ((Xf[:, 1, None] - cx) * (Yf[:, 2, None] - cy) - (Xf[:, 2, None] - cx) * (Yf[:, 1, None] - cy)) / a
-            b1 = ((Xf[:, 2, None] - cx) * (Yf[:, 0, None] - cy) - (Xf[:, 0, None] - cx) * (Yf[:, 2, None] - cy)) / a
-            b2 = 1.0 - b0 - b1
-            inside = (b0 >= 0) & (b1 >= 0) & (b2 >= 0) & (px < width) & (py < height)
-            if not inside.any():
-                continue
-            r, c = np.nonzero(inside)
-            ff = F[fi[r]]
-            bb0, bb1, bb2 = b0[r, c], b1[r, c], b2[r, c]
-            key = bb0 * inv[ff[:, 0]] + bb1 * inv[ff[:, 1]] + bb2 * inv[ff[:, 2]]
-            col = bb0[:, None] * vc[ff[:, 0]] + bb1[:, None] * vc[ff[:, 1]] + bb2[:, None] * vc[ff[:, 2]]
-            pix_all.append(py[r, c] * width + px[r, c])
-            key_all.append(key)
-            col_all.append(col)
-    image = np.empty((height * width, 3), dtype=np.float64)
-    image[:] = background
-    if pix_all:
-        pix = np.concatenate(pix_all)
-        key = np.concatenate(key_all)
-        col = np.concatenate(col_all)
-        nearest = np.full(height * width, -np.inf)
-        np.maximum.at(nearest, pix, key)  # the largest 1/z of every pixel: a z-buffer (50x a sort at 1M fragments)
-        front = key == nearest[pix]
-        image[pix[front]] = col[front]
-    return (np.clip(image, 0.0, 1.0) * 255 + 0.5).astype(np.uint8).reshape(height, width, 3)
-
-
-def _fmt(x):
-    return f"{x:.3g}" if x != 0 else "0"
-
-
-def _colorbar_html(lut, vmin, vmax, label, n_nan, width):
-    # 17 stops sampled from the map
-    samples = lut[:: max(1, len(lut) // 16)]
-    samples = np.vstack([samples, lut[-1:]])
-    stops = ", ".join(
-        f"rgb({int(r * 255)},{int(g * 255)},{int(b * 255)}) {100 * i / (len(samples) - 1):.1f}%"
-        for i, (r, g, b) in enumerate(samples.tolist())
-    )
-    nan_text = ""
-    if n_nan:
-        grey = "rgb({},{},{})".format(*(int(c * 255) for c in NAN_COLOR))
-        nan_text = (
-            f'<span style="display:inline-block;width:10px;height:10px;background:{grey};'
-            f'margin:0 3px 0 8px"></span>NaN ({n_nan})'
-        )
-    label_html = f"<div style='text-align:center'>{html.escape(label)}{nan_text}</div>" if (label or nan_text) else ""
-    return (
-        f"<div class='geomlib-colorbar' style='width:{width}px;font:12px sans-serif;color:#222'>"
-        "<div style='display:flex;align-items:center;gap:6px'>"
-        f"<span class='geomlib-vmin'>{_fmt(vmin)}</span>"
-        f"<div style='flex:1;height:12px;border:1px solid #888;background:linear-gradient(to right, {stops})'></div>"
-        f"<span class='geomlib-vmax'>{_fmt(vmax)}</span></div>{label_html}</div>"
-    )
-
-
-def _zero_html(text, label, width):
-    label_html = f"<div style='text-align:center'>{html.escape(label)}</div>" if label else ""
-    return (
-        f"<div class='geomlib-colorbar geomlib-zero' style='width:{width}px;font:12px sans-serif;"
-        f"color:#222'><div style='border:1px solid #888;background:#fff;text-align:center'>"
-        f"{html.escape(text)}</div>{label_html}</div>"
-    )
-
-
-def _still_with_colorbar(image, lut, vmin, vmax, label, title):
-    """Add the title above and a colour bar with its range below the still picture."""
-    from PIL import Image, ImageDraw, ImageFont
-
-    h, w = image.shape[:2]
-    top = 18 if title else 0
-    bottom = 38 if lut is not None else 0
-    canvas = Image.new("RGB", (w, h + top + bottom), "white")
-    canvas.paste(Image.fromarray(image), (0, top))
-    draw = ImageDraw.Draw(canvas)
-    font = ImageFont.load_default()
-    if title:
-        draw.text((4, 3), title, fill=(20, 20, 20), font=font)
-    if lut is not None:
-        lo, hi = _fmt(vmin), _fmt(vmax)
-        x0, x1 = 8 + 7 * len(lo), w - 8 - 7 * len(hi)
-        y = h + top + 6
-        if x1 > x0:
-            t = np.linspace(0, 1, x1 - x0)
-            strip = (lut[np.round(t * (len(lut) - 1)).astype(int)] * 255).astype(np.uint8)
-            canvas.paste(Image.fromarray(np.repeat(strip[None], 10, axis=0)), (x0, y))
-            draw.rectangle([x0 - 1, y - 1, x1, y + 10], outline=(120, 120, 120))
-        draw.text((4, y), lo, fill=(20, 20, 20), font=font)
-        draw.text((x1 + 4, y), hi, fill=(20, 20, 20), font=font)
-        if label:
-            draw.text((w // 2 - 3 * len(label), y + 14), label, fill=(20, 20, 20), font=font)
-    return np.asarray(canvas)
-
-
-def _png(image):
-    from PIL import Image
-
-    buf = io.BytesIO()
-    Image.fromarray(image).save(buf, format="PNG", optimize=False, compress_level=3)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 # ----------------------------------------------------------------------------
@@ -598,7 +257,7 @@ class MeshView:
     V : (n, 3) float64
         Vertex positions.
     F : (m, 3) int64
-        Triangles (0-based vertex indices).
+        Triangles (0-based vertex indices); a face that repeats a vertex draws nothing.
     values : (n,) float64 or None
         Per-vertex scalar to colour by; None gives plain shading and no colour bar.
     cmap : str or None
@@ -664,28 +323,29 @@ class MeshView:
         import ipywidgets as widgets
         import pythreejs as three
 
-        V = _check_vertices(V)
+        V = as_vertices(V)
         self._n = V.shape[0]
-        self._F = _check_faces(F, self._n)
-        # prepared once: corner columns and the float32 corner matrix for the normals
-        self._Fc = [np.ascontiguousarray(self._F[:, c]) for c in range(3)]
-        self._S32 = _corner_matrix(self._F, self._n).astype(np.float32)
+        # a face that repeats a vertex is drawn as nothing, not refused: a view shows any mesh
+        # that can be drawn; the normals, edges and volume come from the real triangles
+        self._F = as_faces(F, self._n, allow_repeated=True)
+        repeated = repeated_vertex_faces(self._F)
+        self._triangles = np.delete(self._F, repeated, axis=0) if len(repeated) else self._F
+        if len(self._triangles) == 0:
+            raise MeshError("every face of F repeats a vertex: there is no triangle to draw")
         self._V = V
         self._values = None if values is None else _check_values(values, self._n)
         self.symmetric = bool(symmetric)
         self.cmap = cmap if cmap is not None else ("RdBu_r" if symmetric else "viridis")
-        self._lut = _lut(self.cmap)
+        self._lut = colour_table(self.cmap)
         self._fixed = (vmin, vmax)
         self.width, self.height = int(width), int(height)
         self.title, self.label = title, label
-        if up not in VIEWS:
-            raise MeshError(f"up must be one of 'x', 'y', 'z' (the axis drawn upwards); got {up!r}")
-        self.up = up
+        self.up = check_choice("up", up, tuple(VIEWS))
         self._up, self._direction = VIEWS[up]
         self.zero_tol = float(zero_tol)
-        self._centre, self._radius = _frame(V if frame is None else _check_vertices(frame, name="frame"))
+        self._centre, self._radius = bounding_frame(V if frame is None else as_vertices(frame, where="frame"))
         self._scale = 1.0  # drawn this many times larger (side_by_side enlarges specks)
-        self._distance = _camera_distance(self._radius, self.width, self.height)
+        self._distance = camera_distance(self._radius, self.width, self.height)
 
         # one interleaved float32 buffer: position (0:3), normal (3:6), colour (6:9)
         self._buffer = three.InterleavedBuffer(array=self._pack())
@@ -699,7 +359,7 @@ class MeshView:
         # closed outward meshes: back faces are hidden anyway and skipping them
         # halves the software rasteriser's work; open or inconsistently oriented
         # meshes show both sides
-        self.closed = _closed_outward(V, self._F)
+        self.closed = _closed_outward(V, self._triangles)
         material = three.ShaderMaterial(
             vertexShader=_VERTEX_SHADER,
             fragmentShader=_FRAGMENT_SHADER,
@@ -714,8 +374,7 @@ class MeshView:
         self.mesh = three.Mesh(geometry=self.geometry, material=material)
         children = [self.mesh]
         if wireframe:
-            E = np.sort(self._F[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-            E = np.unique(E, axis=0)
+            E = edges(self._triangles)
             lines = three.BufferGeometry(
                 index=three.BufferAttribute(array=E.astype(np.uint32).ravel(), normalized=False),
                 attributes={"position": position},
@@ -732,7 +391,7 @@ class MeshView:
             aspect=self.width / self.height,
             near=self._distance * 0.01,
             far=self._distance * 100.0,
-            position=tuple(float(x) for x in _basis(self._direction, self._up)[2] * self._distance),
+            position=tuple(float(x) for x in camera_basis(self._direction, self._up)[2] * self._distance),
             quaternion=_look_at_quaternion(self._direction, self._up),
             up=self._up,
         )
@@ -824,10 +483,9 @@ class MeshView:
         buf = np.empty((self._n, 9), dtype=np.float32)
         if V:
             # positions relative to the first bounding-box centre (float32 keeps
-            # its precision near the origin); normals in float32 from those
-            P = (self._V - self._centre).astype(np.float32)
-            buf[:, 0:3] = P
-            buf[:, 3:6] = _normalise(_face_normal_sums(P, self._Fc, self._S32))
+            # its precision near the origin)
+            buf[:, 0:3] = self._V - self._centre
+            buf[:, 3:6] = view_normals(self._V, self._triangles)
         else:
             buf[:, 0:6] = old[:, 0:6]
         if colors:
@@ -850,13 +508,15 @@ class MeshView:
             return ""
         n_nan = int(np.isnan(self._values).sum())
         if self.is_zero:
-            return _zero_html(self._zero_text(), self.label or "", self.width)
+            return zero_html(self._zero_text(), self.label or "", self.width)
         lo, hi = self.range
-        return _colorbar_html(self._lut, lo, hi, self.label or "", n_nan, self.width)
+        return colorbar_html(self._lut, lo, hi, self.label or "", n_nan, self.width)
 
     def _zero_text(self):
         largest = float(np.nanmax(np.abs(self._values)))
-        return f"0 everywhere, up to rounding (largest |value| {_fmt(largest)} <= {_fmt(self.zero_tol)})"
+        return (
+            f"0 everywhere, up to rounding (largest |value| {format_value(largest)} <= {format_value(self.zero_tol)})"
+        )
 
     # -- updates ---------------------------------------------------------------
 
@@ -877,7 +537,7 @@ class MeshView:
         """
         new_V = V is not None
         if new_V:
-            self._V = _check_vertices(V, self._n)
+            self._V = _check_count(as_vertices(V), self._n)
         new_colors = False
         if values is not None:
             self._values = _check_values(values, self._n)
@@ -920,7 +580,7 @@ class MeshView:
             title = f"{title} (drawn {self._scale:.3g} x larger)"
         if self.is_zero:
             title = f"{title or ''}  [{self.label or 'values'}: 0 everywhere]".strip()
-        return _still_with_colorbar(image, lut, lo, hi, self.label or "", title)
+        return still_with_colorbar(image, lut, lo, hi, self.label or "", title)
 
     def summary(self):
         """One line of text describing the view (the text/plain display)."""
@@ -934,15 +594,15 @@ class MeshView:
         elif self._values is not None:
             lo, hi = self.range
             name = self.label or "values"
-            text += f"; {name} coloured by {self.cmap} over [{_fmt(lo)}, {_fmt(hi)}]"
+            text += f"; {name} coloured by {self.cmap} over [{format_value(lo)}, {format_value(hi)}]"
             n_nan = int(np.isnan(self._values).sum())
             if n_nan:
                 text += f", {n_nan} NaN drawn grey"
         return text
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
-        bundle["image/png"] = _png(self.still())
+        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle["image/png"] = png_base64(self.still())
         bundle["text/plain"] = self.summary()
         return bundle
 
@@ -961,11 +621,11 @@ class ViewRow:
 
     def still(self):
         """(h, w, 3) uint8: the still pictures of the views next to each other."""
-        return _in_a_row([v.still(distance=self._distance) for v in self.views])
+        return in_a_row([v.still(distance=self._distance) for v in self.views])
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
-        bundle["image/png"] = _png(self.still())
+        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle["image/png"] = png_base64(self.still())
         bundle["text/plain"] = "\n".join(v.summary() for v in self.views)
         return bundle
 
@@ -976,16 +636,6 @@ class ViewRow:
 # widget model id -> the MeshView or ViewRow that made the widget (weak: a
 # view the notebook dropped is not kept alive for its picture)
 _SHOWN = weakref.WeakValueDictionary()
-
-
-def _in_a_row(images):
-    h = max(im.shape[0] for im in images)
-    gap = np.full((h, 8, 3), 255, dtype=np.uint8)
-    parts = []
-    for im in images:
-        pad = np.full((h - im.shape[0], im.shape[1], 3), 255, dtype=np.uint8)
-        parts += [np.vstack([im, pad]), gap]
-    return np.hstack(parts[:-1])
 
 
 def box_still(box):
@@ -1006,16 +656,31 @@ def box_still(box):
             collect(child)
 
     collect(box)
-    return _in_a_row(images) if images else None
+    return in_a_row(images) if images else None
 
 
 def _box_png(box):
     image = box_still(box)
-    return None if image is None else _png(image)
+    return None if image is None else png_base64(image)
+
+
+def stills_only():
+    """Whether views are shown as still pictures without their widgets: while nbgrader runs
+    the notebook, whose feedback pages are static HTML (a widget there is an empty placeholder)."""
+    return graded()
+
+
+def _widget_stills_only(widget):
+    image = box_still(widget)
+    if image is None:  # a slider, a progress bar, an Output widget: its text, as without a front-end
+        return {"text/plain": repr(widget)}
+    return {"image/png": png_base64(image), "text/plain": "still picture of the 3D views (live in Jupyter)"}
 
 
 def _give_boxes_stills():
-    """In IPython, display every ipywidgets box with the still of its views as image/png."""
+    """In IPython, display every ipywidgets box with the still of its views as image/png
+    (with ``stills_only``, every widget without its widget view: a box as the still of
+    its views, any other as its text)."""
     from IPython import get_ipython
 
     shell = get_ipython()
@@ -1023,6 +688,8 @@ def _give_boxes_stills():
         import ipywidgets
 
         shell.display_formatter.formatters["image/png"].for_type(ipywidgets.Box, _box_png)
+        if stills_only():
+            shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_stills_only)
 
 
 _give_boxes_stills()
@@ -1071,9 +738,9 @@ def side_by_side(*views, link_cameras=True):
             scale = radius / r if r < SPECK_RATIO * radius else 1.0
             for v in members:
                 v._set_scale(scale)
-        distance = _camera_distance(radius, first.width, first.height)
+        distance = camera_distance(radius, first.width, first.height)
         cam = first.camera
-        cam.position = tuple(float(x) for x in _basis(first._direction, first._up)[2] * distance)
+        cam.position = tuple(float(x) for x in camera_basis(first._direction, first._up)[2] * distance)
         cam.near, cam.far = distance * 0.01, distance * 100.0
         for v in views:
             v._distance = distance

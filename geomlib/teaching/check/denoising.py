@@ -45,11 +45,13 @@ def _array(out, n, what):
         raise Mistake(
             f"{what} returned {type(out).__name__}, not a numpy array of positions",
             "return V + noise, an (n, 3) numpy array",
+            typical=False,
         )
     if out.shape != (n, 3):
         raise Mistake(
             f"{what} returned shape {out.shape}, expected ({n}, 3): one position per vertex",
             "add an (n, 3) array of noise to V",
+            typical=False,
         )
     return out.astype(float)
 
@@ -132,7 +134,7 @@ def add_noise(fn):
     if not np.allclose(zero, V, rtol=0, atol=1e-12 * d):
         raise Mistake("sigma = 0 still moved the vertices", "the noise must be sigma * d times the unit noise")
     if np.allclose(D, 0):
-        raise Mistake("the vertices did not move", "add the noise to V and return the result")
+        raise Mistake("the vertices did not move", "add the noise to V and return the result", typical=False)
     std = float(D.std())
     mean = D.mean(axis=0)
     if np.any(np.abs(mean) > 5 * std / np.sqrt(n)):
@@ -155,6 +157,7 @@ def add_noise(fn):
             f"the noise has standard deviation {std:.3g} per coordinate, expected s = sigma * d = "
             f"{_SIGMA:g} * {d:.4g} = {s:.4g} (within {_STD_TOLERANCE:.0%})",
             "multiply standard normal numbers by sigma times the bounding-box diagonal of V",
+            typical=False,
         )
     z = (D / std).ravel()
     kurtosis = float(np.mean(z**4))
@@ -246,6 +249,7 @@ def vertex_rms(fn):
             raise Mistake(
                 f"the function returned an array of shape {out.shape}, not one number",
                 "average over all vertices, so the result is a single float",
+                typical=False,
             )
         try:
             value = float(out)
@@ -253,6 +257,7 @@ def vertex_rms(fn):
             raise Mistake(
                 f"the function returned {type(out).__name__}, not a number",
                 "return one float, the RMS distance divided by the diagonal",
+                typical=False,
             ) from None
         d = bounding_box_diagonal(V_clean)
         e2 = np.einsum("ij,ij->i", V - V_clean, V - V_clean)
@@ -268,5 +273,6 @@ def vertex_rms(fn):
         raise Mistake(
             f"on {label} the result is {value:.6g}, expected {expected:.6g}",
             "RMS = sqrt(mean_i |x_i - x_i^clean|^2) / d, d the clean mesh's bounding-box diagonal",
+            typical=False,
         )
     return checked

@@ -39,11 +39,13 @@ def positions(out, n, what="the function"):
         raise Mistake(
             f"{what} returned shape {P.shape}, expected ({n}, 3): one new position per vertex",
             "return the (n, 3) array of new positions, like P",
+            typical=False,
         )
     if not np.isfinite(P.astype(float)).all():
         raise Mistake(
             f"{what} returned NaN or infinite positions",
             "divide by the vertex areas M_ii, which are positive on these meshes",
+            typical=False,
         )
     return P.astype(float)
 
@@ -93,6 +95,7 @@ def explicit_step(fn):
                 f"the new positions differ from P + tau M^-1 C P on {label} "
                 f"(largest difference {np.abs(out - P - move).max():.3g})",
                 "one step is one sparse product: P + tau * (C @ P) / M.diagonal()[:, None]",
+                typical=False,
             )
         checked.append(label)
     return checked
@@ -120,6 +123,7 @@ def explicit_step_limit(fn):
             raise Mistake(
                 f"the function returned {type(out).__name__} {np.shape(out)}, not one number",
                 "return the float 2 / lam_max",
+                typical=False,
             ) from None
         if np.isclose(tau, 2 / lam_max, rtol=1e-6):
             checked.append(label)
@@ -157,5 +161,6 @@ def explicit_step_limit(fn):
         raise Mistake(
             f"the limit {tau:.6g} differs from 2 / lam_max = {2 / lam_max:.6g} on {label}",
             "lam_max is the largest eigenvalue of -M^-1 C; the limit is 2 / lam_max",
+            typical=False,
         )
     return checked

@@ -27,6 +27,7 @@ def _expressions(out):
             raise Mistake(
                 f"the forms have shapes {I.shape} and {II.shape}, expected two 2 x 2 matrices",
                 "return (I, II) with I = Matrix([[E, F], [F, G]]) and II = Matrix([[e, f], [f, g]])",
+                typical=False,
             )
         for name, A in (("I", I), ("II", II)):
             if sp.simplify(A[0, 1] - A[1, 0]) != 0:
@@ -37,6 +38,7 @@ def _expressions(out):
     raise Mistake(
         f"the function returned {type(out).__name__}, not (E, F, G, e, f, g) or (I, II)",
         "end with `return E, F, G, e, f, g` (sympy expressions in a, b, c, u, v)",
+        typical=False,
     )
 
 
@@ -55,6 +57,7 @@ def _values(exprs, symbols, points):
         raise Mistake(
             "the expressions are not real numbers at points inside the domain",
             "check square roots and divisions: 0 < v < pi, a, b, c > 0",
+            typical=False,
         )
     return vals.real
 
@@ -112,6 +115,7 @@ def fundamental_forms(fn):
         raise Mistake(
             f"{', '.join(wrong)} of the first fundamental form differ from p_u . p_u, p_u . p_v, p_v . p_v",
             "differentiate p(u, v) = (a cos u sin v, b sin u sin v, c cos v) once in u and once in v",
+            typical=False,
         )
     if _same(second, ref[3:]):
         return ["E, F, G, e, f, g at three generic points (F != 0) of three ellipsoids"]
@@ -143,6 +147,7 @@ def fundamental_forms(fn):
     raise Mistake(
         f"{', '.join(wrong)} of the second fundamental form differ from p_uu . N, p_uv . N, p_vv . N",
         "take the second derivatives of p and dot them with the unit normal N = p_u x p_v / |p_u x p_v|",
+        typical=False,
     )
 
 
@@ -165,6 +170,7 @@ def normal_curvature(fn):
                     f"the function returned {type(out).__name__} ({out!s:.60}), not a number",
                     "return kappa_n as one number for the given a, b, c, phi (substitute them "
                     "into a sympy expression, or write it with numpy)",
+                    typical=False,
                 ) from None
     a, b, c = (_AXES[:, k, None] for k in range(3))
     cos2, sin2 = np.cos(_PHIS) ** 2, np.sin(_PHIS) ** 2
@@ -214,4 +220,5 @@ def normal_curvature(fn):
     raise Mistake(
         "kappa_n differs from II(t, t) / I(t, t) at (a, 0, 0)",
         "at (a, 0, 0): I = diag(b^2, c^2), II = diag(a, a), (du, dv) = (cos phi / b, sin phi / c)",
+        typical=False,
     )

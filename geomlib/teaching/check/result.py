@@ -26,29 +26,60 @@ Writing a check::
 Under the test suite's strict mode (``GEOMLIB_STRICT_CLAIMS=1``) a failed check
 of a function that is written (not a stub) raises ``CheckFailed``, so a
 solution notebook whose own answer fails its check fails its test.
+
+Graded by nbgrader
+------------------
+While nbgrader runs a notebook (``autograde``, ``validate``: ``NBGRADER_EXECUTION``
+is set) every failed check raises ``CheckFailed`` with its diagnosis, stubs
+included, so the grade cell that called it loses its points and the feedback
+page shows the diagnosis. Each exercise has two grade cells:
+
+* ``check.NAME(fn)``: all of the exercise's remaining points, for a function
+  that passes;
+* ``check.NAME.partial_credit(fn)``: one point, for a function that is right
+  or whose first mistake is one the check names (``Mistake(..., typical=True)``,
+  the default). A catch-all diagnosis ("C differs from ..."), a wrong shape or
+  type, an exception or a stub earn nothing.
+
+``use`` calls ``check.NAME.evaluate(fn)``, which never raises, so the cells after
+an exercise run on geomlib's own function in every mode. Warnings raised by the
+learner's function while nbgrader grades are silenced: nbgrader scores a grade
+cell that wrote to stderr as failed.
 """
 
+import contextlib
 import functools
 import html
+import warnings
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..notebook import strict_claims
+from ..notebook import graded, strict_claims
 
 __all__ = ["CheckResult", "CheckFailed", "Mistake", "exercise", "call", "matrix_pair", "vector", "close", "use"]
 
 
 class CheckFailed(AssertionError):
-    """A written (non-stub) function failed its check under the strict test run."""
+    """A function failed its check while nbgrader grades, or a written one under the strict test run."""
+
+    def _render_traceback_(self):
+        # IPython shows these lines instead of the frames: under the grade cell a reader
+        # (and nbgrader's feedback page) gets the diagnosis, not geomlib's insides
+        return [f"{type(self).__name__}: {self}"]
 
 
 class Mistake(Exception):
-    """Raised inside a check: ``diagnosis`` names the mistake, ``hint`` says how to fix it."""
+    """Raised inside a check: ``diagnosis`` names the mistake, ``hint`` says how to fix it.
 
-    def __init__(self, diagnosis, hint=""):
+    ``typical=False`` marks a diagnosis that can only say *that* something is wrong (a
+    catch-all "differs from", a wrong shape or type), not which typical mistake it is:
+    no partial credit under nbgrader.
+    """
+
+    def __init__(self, diagnosis, hint="", typical=True):
         super().__init__(diagnosis)
-        self.diagnosis, self.hint = diagnosis, hint
+        self.diagnosis, self.hint, self.typical = diagnosis, hint, typical
 
 
 class _NotWritten(Exception):
@@ -63,10 +94,14 @@ class CheckResult:
     name : str       the exercise
     passed : bool
     message : str    what was checked (passed) or the diagnosis, hint and what to reread
+    written : bool   False for a stub (the function raises NotImplementedError)
+    partial : bool   passed, or failed by a typical mistake the check names (partial credit)
     """
 
-    def __init__(self, name, passed, message):
+    def __init__(self, name, passed, message, written=True, partial=None):
         self.name, self.passed, self.message = name, bool(passed), message
+        self.written = bool(written)
+        self.partial = self.passed if partial is None else bool(partial)
 
     def __bool__(self):
         return self.passed
@@ -83,6 +118,13 @@ class CheckResult:
             f"{html.escape(self.message)}</div>"
         )
 
+    def _ipython_display_(self):
+        # shown as display data, not as the cell's result: nbgrader would try to read a
+        # grade cell's result as its partial score
+        from IPython.display import display
+
+        display({"text/plain": repr(self), "text/html": self._repr_html_()}, raw=True)
+
 
 def call(fn, *args):
     """Call the learner's function; turn its exceptions into a diagnosis."""
@@ -96,6 +138,7 @@ def call(fn, *args):
         raise Mistake(
             f"the function raised {type(exc).__name__}: {exc}",
             "run it on the small example in the cell above and read the traceback",
+            typical=False,
         ) from None
 
 
@@ -109,6 +152,7 @@ def matrix_pair(out, n):
         raise Mistake(
             f"the function returned {type(out).__name__}, not the pair (M, C)",
             "end with `return M, C`, M the diagonal mass matrix and C the weight matrix",
+            typical=False,
         )
     M, C = (_dense(A) for A in out)
     for name, A in (("M", M), ("C", C)):
@@ -118,6 +162,7 @@ def matrix_pair(out, n):
             raise Mistake(
                 f"{name} has shape {A.shape}, expected ({n}, {n}) for a mesh with {n} vertices",
                 "one row and one column per vertex",
+                typical=False,
             )
     return M.astype(float), C.astype(float)
 
@@ -129,6 +174,7 @@ def vector(out, n, what="the function"):
         raise Mistake(
             f"{what} returned shape {x.shape}, expected ({n},): one value per vertex",
             "return a flat numpy array with one entry per vertex",
+            typical=False,
         )
     return x.reshape(n)
 
@@ -139,30 +185,61 @@ def close(a, b, rtol=1e-8, atol=1e-10):
     return a.shape == b.shape and np.allclose(a, b, rtol=rtol, atol=atol)
 
 
+@contextlib.contextmanager
+def _quiet_while_graded():
+    with warnings.catch_warnings():
+        if graded():
+            warnings.simplefilter("ignore")
+        yield
+
+
+def _enforce(result):
+    """``result``, or CheckFailed with its message: for any failure while nbgrader grades,
+    for a written function's failure under the strict test run."""
+    if not result.passed and (graded() or (strict_claims() and result.written)):
+        raise CheckFailed(f"{result.name}: {result.message}")
+    return result
+
+
 def exercise(name, reread):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring)."""
 
     def wrap(body):
-        @functools.wraps(body)
-        def check(fn):
+        def evaluate(fn):
+            """The CheckResult of ``fn``; never raises."""
             try:
-                checked = body(fn)
+                with _quiet_while_graded():
+                    checked = body(fn)
             except _NotWritten as exc:
                 detail = f" ({exc})" if str(exc) else ""
-                return CheckResult(
-                    name,
-                    False,
-                    f"not written yet: the function raises NotImplementedError{detail}. "
-                    f"Reread {reread} and fill it in.",
+                message = (
+                    f"not written yet: the function raises NotImplementedError{detail}. Reread {reread} and fill it in."
                 )
+                return CheckResult(name, False, message, written=False)
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
-                if strict_claims():
-                    raise CheckFailed(f"{name}: {message}") from None
-                return CheckResult(name, False, message)
+                return CheckResult(name, False, message, partial=m.typical)
             return CheckResult(name, True, "checked on " + ", ".join(checked) + ".")
 
+        @functools.wraps(body)
+        def check(fn):
+            return _enforce(evaluate(fn))
+
+        def partial_credit(fn):
+            """Partial credit: ``fn`` is right, or the first thing wrong is a typical mistake the check names."""
+            result = evaluate(fn)
+            if result.passed:
+                message = "earned: the function passes its check."
+            elif result.partial:
+                message = "earned: what is wrong is a typical mistake, named by the check above."
+            elif not result.written:
+                message = result.message
+            else:
+                message = f"not earned: the check cannot name what is wrong. {result.message}"
+            return _enforce(CheckResult(f"{name}, partial credit", result.partial, message, written=result.written))
+
         check.exercise, check.reread = name, reread
+        check.evaluate, check.partial_credit = evaluate, partial_credit
         return check
 
     return wrap
@@ -173,7 +250,7 @@ def use(fn, check, reference):
 
     Lets the cells after an unfinished exercise run on geomlib's own function.
     """
-    result = check(fn)
+    result = check.evaluate(fn)
     if result.passed:
         print(f"Using your {fn.__name__} (its check passed).")
         return fn

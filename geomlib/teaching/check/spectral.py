@@ -45,6 +45,7 @@ def _positions(out, n, k):
         raise Mistake(
             f"the function returned shape {X.shape}, expected ({n}, 3): one position per vertex",
             "return E_k @ (E_k.T @ (M @ V))",
+            typical=False,
         )
     return X
 
@@ -115,6 +116,7 @@ def spectral_reconstruction(fn):
                 f"V_k differs from the M-orthogonal projection at k = {k} "
                 f"(largest difference {np.abs(X - ref).max():.3g}, coordinates up to {scale:.3g})",
                 "V_k = E_k (E_k^T M V), with E_k = E[:, :k]",
+                typical=False,
             )
         checked.append(f"a 42-vertex jittered ellipsoid with k = {k}" + (" (gives V back)" if k == n else ""))
     return checked

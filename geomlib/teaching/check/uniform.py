@@ -48,13 +48,14 @@ def uniform_laplacian(fn):
             raise Mistake(
                 f"C differs from the uniform Laplacian on {label}",
                 "C_ij = 1 for neighbours, C_ii = -valence, 0 elsewhere",
+                typical=False,
             )
         if close(M, np.eye(len(V))):
             raise Mistake("M is the identity", "M = diag(valence), the number of neighbours of each vertex")
         if close(M, -M_ref):
             raise Mistake("M has the wrong sign", "M holds positive valences")
         if not close(M, M_ref):
-            raise Mistake(f"M differs from diag(valence) on {label}", "M_ii = number of neighbours of i")
+            raise Mistake(f"M differs from diag(valence) on {label}", "M_ii = number of neighbours of i", typical=False)
         checked.append(label)
     return checked
 
@@ -126,6 +127,7 @@ def gaussian_curvature(fn):
             raise Mistake(
                 f"K differs from the angle-deficit curvature at interior vertices of {label}",
                 "K_i = (2 pi - sum of the angles at i) / (a third of the incident triangle areas)",
+                typical=False,
             )
         boundary = ~inner
         if boundary.any() and not np.all(np.isnan(K[boundary])):
