@@ -1,10 +1,38 @@
 """Eigenpairs of sparse symmetric positive semidefinite matrices: the smallest few, the largest one.
 
 * :func:`smallest_eigenpairs` -- the k smallest eigenpairs of S: dense LAPACK
-  (``scipy.linalg.eigh``) for small matrices, else ARPACK's Lanczos iteration
-  (``scipy.sparse.linalg.eigsh``) in shift-invert mode around ``-shift``, with
-  ``(S + shift I)^-1`` applied by one sparse Cholesky factorisation
-  (:mod:`geomlib.numerics.factor`) computed once.
+  (``scipy.linalg.eigh``) for small matrices, else :func:`shift_invert_lanczos`,
+  block Lanczos on ``(S + shift I)^-1`` applied by one sparse Cholesky
+  factorisation (:mod:`geomlib.numerics.factor`) computed once.
+
+  Why a Lanczos iteration of its own and not ARPACK (``eigsh`` with the same
+  factorisation as ``OPinv``): at k = 200 most of ARPACK's time is not in the
+  solves but in its vector work, done one vector at a time (BLAS level 2), and
+  in forming the Ritz vectors from Householder reflections at the end (about
+  40 % of its time at 10k vertices). Here the basis grows by blocks of
+  ``BLOCK`` vectors (one multi-column Cholesky solve, one matrix product per
+  orthogonalisation), the Ritz vectors are one matrix product, and the Ritz
+  pairs are checked only where the residual's geometric fall says they
+  converge (3-4 checks at k = 200). Measured on the bumpy icosphere of
+  ``benchmarks/bench_spectral.py`` (2 cores shared with other work, load
+  average 5-7, one BLAS thread for both): at 10,242 vertices 0.73x the time
+  of ``eigsh`` at k = 50 and 0.42x at k = 200 (against ``eigsh`` with its
+  default two BLAS threads, which a busy machine slows many times, 0.10x and
+  0.06x). Candidates measured and dropped: ARPACK's subspace size (ncv from
+  1.3 k to 3 k: within 20 %, no trend through the noise), ARPACK on
+  ``(S + shift I)^-2`` (fewer iterations, more solves: no gain at 160k
+  vertices, where a solve costs 32 ms), single-vector Lanczos with full
+  reorthogonalisation (fewer vectors, about 460 against 600-650 at 10k
+  vertices, k = 200, but each orthogonalisation is a memory-bound
+  matrix-vector product: no faster in our runs, 2.2 s against 1.9-3.4 s for
+  blocks of 8 at load averages of 4-6, and one start vector finds only one
+  vector of a repeated eigenvalue, as on an icosphere), blocks of 16 or 32
+  (20-60 % more vectors than blocks of 8). LOBPCG
+  (its Rayleigh-Ritz step on 3k vectors costs n (3k)^2 per iteration) and
+  Vallet and Levy's band-by-band shift-invert (each band needs a factorisation
+  of the indefinite ``S - sigma I``, which the Cholesky binding cannot do;
+  SuperLU factorises 3x slower than CHOLMOD at 160k vertices) were not
+  faster on paper and were not built.
 * :func:`largest_eigenpair` -- the largest eigenpair, by ARPACK without any
   factorisation (only products with S are needed).
 * :func:`largest_eigenvalue` -- the largest eigenvalue alone, by a plain
@@ -17,10 +45,12 @@
   of the eigenvector, which converges slowly inside a cluster; the extreme
   Ritz value itself converges fast, and that is all the limit needs.
 
-Both run with one BLAS thread (``threadpoolctl``): on 2-core machines shared
+All run with one BLAS thread (``threadpoolctl``): on 2-core machines shared
 with other busy processes, a 2-thread BLAS pool made dense ``eigh`` at 642
 vertices 20x slower (2.1 s instead of 0.1 s) and ARPACK's vector work several
-times slower, while the sparse factorisation does not use BLAS threads anyway.
+times slower (``eigsh`` at 10k vertices, k = 200: 112 s with two threads
+against 15 s with one at load average 6), while the sparse factorisation
+does not use BLAS threads anyway.
 """
 
 import numpy as np
