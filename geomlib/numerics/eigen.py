@@ -155,7 +155,7 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
     """
     b = min(block, k)
     rng = np.random.default_rng(0)
-    Q = np.empty((n, min(n, k + 8 * int(np.sqrt(k)) + 4 * b)), order="F")
+    Q = np.empty((n, min(n, 3 * k + 30 * int(np.sqrt(k)) + 4 * b)), order="F")  # untouched columns cost no memory
     T = np.zeros((Q.shape[1] + b, Q.shape[1] + b))
     Qj = la.qr(rng.uniform(-1.0, 1.0, (n, b)), mode="economic")[0]
     j, check, last = 0, k + 6 * np.sqrt(k) + 2 * b, None
@@ -165,19 +165,19 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
             Q = np.asfortranarray(np.hstack([Q, np.empty((n, grown - Q.shape[1]))]))
             T = np.pad(T, (0, grown + b - T.shape[0]))
         Q[:, j : j + b] = Qj
-        W = solve(Qj)
+        W = np.ascontiguousarray(solve(Qj).T)  # (b, n): as rows, the products with Q read it at full speed
         if j:
-            W -= Q[:, j - b : j] @ T[j - b : j, j : j + b]
-        A = Qj.T @ W
+            W -= T[j : j + b, j - b : j] @ Q[:, j - b : j].T
+        A = W @ Qj
         A = 0.5 * (A + A.T)
-        W -= Qj @ A
+        W -= A @ Qj.T
         T[j : j + b, j : j + b] = A
         P = Q[:, : j + b]
-        before = np.einsum("ij,ij->j", W, W)
-        W -= P @ (P.T @ W)
-        if np.any(np.einsum("ij,ij->j", W, W) < 0.5 * before):  # cancellation: orthogonalise again
-            W -= P @ (P.T @ W)
-        Qj, B = la.qr(W, mode="economic", overwrite_a=True, check_finite=False)
+        before = np.einsum("ij,ij->i", W, W)
+        W -= (W @ P) @ P.T
+        if np.any(np.einsum("ij,ij->i", W, W) < 0.5 * before):  # cancellation: orthogonalise again
+            W -= (W @ P) @ P.T
+        Qj, B = la.qr(W.T, mode="economic", check_finite=False)
         j += b
         T[j : j + b, j - b : j] = B
         T[j - b : j, j : j + b] = B.T
