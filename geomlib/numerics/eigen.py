@@ -14,11 +14,16 @@
   orthogonalisation), the Ritz vectors are one matrix product, and the Ritz
   pairs are checked only where the residual's geometric fall says they
   converge (3-4 checks at k = 200). Measured on the bumpy icosphere of
-  ``benchmarks/bench_spectral.py`` (2 cores shared with other work, load
-  average 5-7, one BLAS thread for both): at 10,242 vertices 0.73x the time
-  of ``eigsh`` at k = 50 and 0.42x at k = 200 (against ``eigsh`` with its
-  default two BLAS threads, which a busy machine slows many times, 0.10x and
-  0.06x). Candidates measured and dropped: ARPACK's subspace size (ncv from
+  ``benchmarks/bench_spectral.py`` against ``eigsh`` with one BLAS thread
+  (2 cores shared with other work, load average 3-6, one run each): 0.59x at
+  10k vertices, k = 50; 0.32x at 10k and 40k, k = 200; 0.26x at 160k, k = 200
+  (37 s against 139 s); with the orthogonalisation still written as
+  ``(n, j) @ (j, b)``, 0.34x at 40k and 0.32x at 160k for k = 50. The new
+  block is kept as rows, ``(b, n)``: at 160k vertices ``W @ Q`` and
+  ``(W @ Q) @ Q.T`` read the basis at memory speed, ``Q @ h`` three to four
+  times slower (57 s against 40 s for the whole k = 200 solve). Against
+  ``eigsh`` with its default two BLAS threads, which a busy machine slows many
+  times, the ratios were 0.10x and 0.06x at 10k vertices. Candidates measured and dropped: ARPACK's subspace size (ncv from
   1.3 k to 3 k: within 20 %, no trend through the noise), ARPACK on
   ``(S + shift I)^-2`` (fewer iterations, more solves: no gain at 160k
   vertices, where a solve costs 32 ms), single-vector Lanczos with full
