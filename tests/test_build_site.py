@@ -3,6 +3,7 @@ for a static page, and the check of the pinned downloads."""
 
 import base64
 import hashlib
+import json
 import re
 import sys
 from pathlib import Path
@@ -161,3 +162,32 @@ def test_build_never_replaces_a_folder_it_did_not_make(tmp_path):
     with pytest.raises(SystemExit, match="holds no earlier build"):
         build_site.build(tmp_path, names=["00_getting_started.ipynb"])
     assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
+def test_a_precomputed_slider_stays_enabled_and_says_it_snaps():
+    nb, state = _notebook()
+    state["box"]["state"]["children"].append("IPY_MODEL_drop")
+    state["drop"] = _model("DropdownModel", index=0, disabled=False)
+    slider = {"model_id": "slider", "description": "t", "values": [0.0, 0.5, 1.0], "default": 0, "traits": []}
+    recorded = {0: {"sliders": [slider], "left_out": []}}
+    assert build_site.prepare_for_site(nb, recorded) == 2
+    assert state["slider"]["state"]["disabled"] is False and state["drop"]["state"]["disabled"] is True
+    notes = [o["data"]["text/html"] for o in nb.cells[0].outputs if "note" in str(o)]
+    assert notes == [
+        '<p class="site-snap-note">On this page the slider snaps to the 3 values computed when the page was built.</p>',
+        f'<p class="site-kernel-note">{build_site.KERNEL_NOTE_OTHERS}</p>',
+    ]
+    assert build_site.page_states(recorded) == [{"sliders": [slider]}]
+    assert build_site.page_states({0: {"error": "boom"}, 1: {"sliders": [], "left_out": []}}) == []
+
+
+def test_the_states_are_on_the_page_and_cannot_end_their_script():
+    nb, _ = _notebook()
+    build_site.prepare_for_site(nb)
+    states = [{"sliders": [{"model_id": "slider", "traits": [{"states": ["<b>1</b></script>"]}]}]}]
+    text = json.dumps(states, separators=(",", ":")).replace("</", "<\\/")
+    body, _ = build_site.exporter().from_notebook_node(nb, resources={"site_nav": "", "site_states": text})
+    assert body.count("</script>") == body.count("<script")
+    assert f'<script src="{build_site.STATES_JS}">' in body
+    (inside,) = re.findall(r'<script[^>]*id="site-states"[^>]*>(.*?)</script>', body, re.S)
+    assert json.loads(inside) == states

@@ -467,3 +467,43 @@ def test_ellipsoid_forms_at_a_point_and_kappa_n_at_the_axis_end():
     ell = symbolic.ellipsoid(2.0, 1.5, 0.7)
     assert np.allclose(np.array(I_num, dtype=float), ell.lambdify("first_fundamental_form")(0.7, 1.0), rtol=1e-12)
     assert np.allclose(np.array(II_num, dtype=float), ell.lambdify("second_fundamental_form")(0.7, 1.0), rtol=1e-12)
+
+
+# ------------------------------------------- derived without simplification
+def test_unsimplified_ellipsoid_matches_the_closed_forms_and_stays_finite_at_the_poles():
+    a, b, c = 2.5, 1.2, 0.4
+    u, v, X = ellipsoid_points((a, b, c), 300)
+    u, v = np.r_[u, 0.0, 1.1], np.r_[v, 0.0, np.pi]  # the poles, where p_u = 0
+    x, y, z = np.r_[X[:, 0], 0, 0], np.r_[X[:, 1], 0, 0], np.r_[X[:, 2], c, -c]
+    h = np.sqrt(x**2 / a**4 + y**2 / b**4 + z**2 / c**4)
+    S = ellipsoid(a, b, c, simplify=False)
+    assert not S.simplify
+    K_exact = 1 / (a * b * c) ** 2 / h**4
+    H_exact = np.abs(x**2 + y**2 + z**2 - a**2 - b**2 - c**2) / (2 * (a * b * c) ** 2 * h**3)
+    np.testing.assert_allclose(S.lambdify("gaussian_curvature")(u, v), K_exact, rtol=1e-11)
+    np.testing.assert_allclose(S.lambdify("mean_curvature")(u, v), H_exact, rtol=1e-11)
+    n_exact = np.stack([x / a**2, y / b**2, z / c**2], axis=1) / h[:, None]
+    np.testing.assert_allclose(S.lambdify("unit_normal")(u, v), n_exact, atol=1e-12)
+
+
+X_, Y_ = sp.symbols("x y", real=True)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda simplify: torus(2.0, 0.7, simplify=simplify),
+        lambda simplify: monge(
+            sp.Rational(27, 20) * X_ * (1 - X_**2) * Y_ * (1 - Y_**2) + (X_**3 - 3 * X_ * Y_**2) / 10,
+            X_,
+            Y_,
+            simplify=simplify,
+        ),
+    ],
+)
+def test_unsimplified_surfaces_give_the_simplified_values(make):
+    rng = np.random.default_rng(RNG_SEED)
+    u, v = rng.uniform(-1, 1, 200), rng.uniform(-1, 1, 200)
+    plain, simple = make(False), make(True)
+    for name in ("unit_normal", "mean_curvature", "gaussian_curvature"):
+        np.testing.assert_allclose(plain.lambdify(name)(u, v), simple.lambdify(name)(u, v), rtol=1e-11, atol=1e-13)

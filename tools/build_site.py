@@ -12,11 +12,35 @@ Jupyter widgets HTML manager and pythreejs's browser code, both served from
 needs no kernel and no network. Links are relative: the folder works from any
 static web server and from ``file://``.
 
-Controls that need a kernel (sliders, dropdowns, ...) are shown disabled at
-their default value, with one line saying that they recompute in JupyterLab.
-A view whose widget state was not saved keeps its still picture; so does a
-live view in a browser without WebGL. A cell that raises does not stop the
-build: its page shows the error and the command exits with status 1.
+Sliders move the 3D views in the page too, with no kernel: their states are
+computed when the site is built. After the notebook's last cell has run,
+:func:`geomlib.teaching.site_states.record` runs in the same kernel for every cell
+that showed widgets: it sets each of the cell's sliders, from the value it was left at, one at a time from the others' defaults, to a short list
+of values (every integer up to 10, then 15, 20, 30, 50, 100, ...; a long grid
+thinned to about 20 positions, both ends kept: past a stability limit for the
+step sliders), so the notebook's own observers run as when a reader moves the
+slider, and keeps what they changed in the shown widgets (buffer arrays packed
+in 16 bits and gzip, read-out text). The page carries those states as JSON, and
+a small script of the site's own (tools/site_states.js, loaded after the widget
+manager) snaps the slider to the computed values and sets the recorded traits of
+the page's widget models; the 3D views redraw from their buffer models. A line
+under the slider says it snaps. Why this way: it replays exactly what JupyterLab
+shows for those values (the same callbacks, nothing rewritten in JavaScript),
+it needs nothing from the notebooks, and it is one page script of about 150
+lines to keep. Linking the slider to a keyframe animation (ipywidgets.jslink to
+a pythreejs AnimationAction) would also run without a kernel, but a paused
+action does not redraw in the HTML widget manager, and keyframes would have to
+be built per notebook. A slider whose states are too large (over
+``site_states.MAX_BYTES``) or whose moves change nothing the page can replay is
+not precomputed.
+
+Other controls (dropdowns, toggles, checkboxes, and sliders not precomputed)
+are shown disabled at their default value, with one line saying that they
+recompute in JupyterLab. A view whose widget state was not saved keeps its still
+picture; so does a live view in a browser without WebGL. A cell that raises (or
+whose sliders could not be recorded) does not stop the build: its page shows the
+error and the command exits with status 1. The build prints each page's size and
+number of live controls, and the site's total size.
 
 The JavaScript comes from the npm registry, pinned by version and by the
 registry's sha512 integrity hash (:data:`PACKAGES`); downloads are kept in
@@ -33,6 +57,7 @@ import re
 import shutil
 import sys
 import tarfile
+import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -100,6 +125,8 @@ PACKAGES = {
 REQUIRE_JS = f"{ASSETS}/requirejs/require.js"
 WIDGET_RENDERER = f"{ASSETS}/html-manager/dist/embed-amd.js"
 MATHJAX = f"{ASSETS}/mathjax/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
+#: the project's own page script that moves precomputed sliders (source: tools/site_states.js)
+STATES_JS = f"{ASSETS}/site/site_states.js"
 AMD_PATHS = {
     "jupyter-threejs": f"{ASSETS}/jupyter-threejs/dist/index",
     "jupyter-datawidgets": f"{ASSETS}/jupyter-datawidgets/dist/index",
@@ -109,6 +136,9 @@ WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
 KERNEL_NOTE = "In JupyterLab this control recomputes the result; on this page it stays at its default value."
 KERNEL_NOTE_MANY = "In JupyterLab these controls recompute the result; on this page they stay at their default values."
+KERNEL_NOTE_OTHERS = (
+    "In JupyterLab the other controls recompute the result too; on this page they stay at their defaults."
+)
 
 # ---------------------------------------------------------------------------
 # the pinned JavaScript
@@ -165,8 +195,21 @@ def install_assets(site):
 # ---------------------------------------------------------------------------
 
 
+def _shown(cell):
+    """Model ids of the widgets a cell's outputs display."""
+    return [
+        out["data"][WIDGET_VIEW]["model_id"] for out in cell.get("outputs", []) if WIDGET_VIEW in out.get("data", {})
+    ]
+
+
 def execute(path, timeout=1200):
     """Run the notebook at ``path`` top to bottom in its folder; the widget state is stored.
+
+    After the last cell, :func:`geomlib.teaching.site_states.record` runs in the same
+    kernel for every cell that displayed widgets and records the states of its
+    sliders, from the values they were left at. Returns
+    ``(nb, recorded)`` with ``recorded`` mapping a cell's index to what was recorded
+    (``{"sliders": [...], "left_out": [...]}``, or ``{"error": text}``).
 
     A cell that raises does not stop the run (the page shows the error, like
     JupyterLab would); :func:`cell_errors` lists them.
@@ -182,8 +225,36 @@ def execute(path, timeout=1200):
         allow_errors=True,
         resources={"metadata": {"path": str(path.parent)}},
     )
-    client.execute()
-    return nb
+    # the sliders are recorded after the last cell, in the state the page is saved in (a
+    # later cell may move a slider, and moving one after "Run all" in JupyterLab runs its
+    # callback in that final namespace too): a cell added at the end, removed afterwards
+    after_all = nbformat.v4.new_code_cell("None  # the site's slider states are recorded after this cell")
+    nb.cells.append(after_all)
+    last = len(nb.cells) - 1
+    shown, recorded = {}, {}
+    with tempfile.TemporaryDirectory() as tmp:
+
+        async def record_sliders(cell, cell_index, execute_reply):
+            if cell_index != last:
+                if _shown(cell):
+                    shown[cell_index] = _shown(cell)
+                return
+            if cell is not after_all:  # one of the calls below
+                return
+            for i, ids in shown.items():
+                target = Path(tmp) / f"{i}.json"
+                # a call that leaves no name behind in the reader's namespace
+                probe = nbformat.v4.new_code_cell(
+                    f"__import__('geomlib.teaching.site_states', fromlist=['record']).record({ids!r}, {str(target)!r})"
+                )
+                await client.async_execute_cell(probe, cell_index, store_history=False)
+                errors = [f"{o['ename']}: {o['evalue']}" for o in probe.outputs if o.get("output_type") == "error"]
+                recorded[i] = {"error": "; ".join(errors)} if errors else json.loads(target.read_text())
+
+        client.on_cell_executed = record_sliders
+        client.execute()
+    nb.cells.pop()
+    return nb, recorded
 
 
 def cell_errors(nb):
@@ -228,19 +299,38 @@ def _html_output(text):
     return nbformat.v4.new_output("display_data", data={"text/html": text})
 
 
-def prepare_for_site(nb):
+def snap_note(sliders):
+    """The line under precomputed sliders: they snap to the values computed for the page."""
+    if len(sliders) == 1:
+        return (
+            f"On this page the slider snaps to the {len(sliders[0]['values'])} values computed when the page was built."
+        )
+    names = [f"{s['description']} ({len(s['values'])} values)" for s in sliders]
+    listed = ", ".join(names[:-1]) + " and " + names[-1]
+    return (
+        f"On this page the sliders {listed} snap to values computed when the page was built, "
+        "one at a time: moving one puts the others back to their defaults."
+    )
+
+
+def prepare_for_site(nb, recorded=None):
     """Make an executed notebook fit for a static page (in place); returns the live view count.
 
-    - every control is saved disabled (it cannot recompute without a kernel), and an
-      output that holds one gets a one-line note after it;
+    - a slider whose states were recorded (``recorded``: cell index -> what
+      :func:`execute` recorded) stays enabled, and its output gets a line saying it
+      snaps to the computed values;
+    - every other control is saved disabled (it cannot recompute without a kernel),
+      and an output that holds one gets a one-line note after it;
     - an output whose widget was not saved loses its widget part, so its still
       picture (image/png) or text is shown instead;
     - a live 3D view keeps its still picture, hidden, after it: the page shows it
       when the browser has no WebGL or the view did not appear (script in TEMPLATE).
     """
+    recorded = recorded or {}
     state = nb.metadata.get("widgets", {}).get(WIDGET_STATE, {}).get("state", {})
-    for model in state.values():
-        if _is_control(model):
+    live_sliders = {s["model_id"]: s for r in recorded.values() for s in r.get("sliders", [])}
+    for mid, model in state.items():
+        if _is_control(model) and mid not in live_sliders:
             model["state"]["disabled"] = True
     live = 0
     for cell in nb.cells:
@@ -265,12 +355,20 @@ def prepare_for_site(nb):
                         f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'
                     )
                 )
-            controls = sum(_is_control(state[m]) for m in models)
+            snapping = [s for s in live_sliders.values() if s["model_id"] in models]
+            if snapping:
+                outputs.append(_html_output(f'<p class="site-snap-note">{html.escape(snap_note(snapping))}</p>'))
+            controls = sum(_is_control(state[m]) and m not in live_sliders for m in models)
             if controls:
-                note = KERNEL_NOTE if controls == 1 else KERNEL_NOTE_MANY
+                note = (KERNEL_NOTE if controls == 1 else KERNEL_NOTE_MANY) if not snapping else KERNEL_NOTE_OTHERS
                 outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(note)}</p>'))
         cell.outputs = outputs
     return live
+
+
+def page_states(recorded):
+    """What the page's script needs (tools/site_states.js): per cell, its recorded sliders."""
+    return [{"sliders": r["sliders"]} for _, r in sorted(recorded.items()) if r.get("sliders")]
 
 
 def title_of(nb, fallback):
@@ -294,7 +392,9 @@ TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
 nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
   font-family: var(--jp-ui-font-family); font-size: 14px; border-bottom: 1px solid #ddd; }
 nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
-p.site-kernel-note { font-style: italic; color: #555; margin: 0.2em 0; }
+/* the output area's style sheet shows its images as blocks, which overrides the hidden attribute */
+img.site-still[hidden] { display: none !important; }
+p.site-kernel-note, p.site-snap-note { font-style: italic; color: #555; margin: 0.2em 0; }
 details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 13px;
   font-family: var(--jp-ui-font-family); margin: 0.3em 0 0.3em 6em; }
 /* the widget style sheets take their font from a variable only JupyterLab's own page defines */
@@ -318,15 +418,23 @@ details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 1
 {%- endblock body_header -%}
 {% block body_footer %}
 {{ resources.site_nav.replace('class="site-nav"', 'class="site-nav bottom"') }}
+{%- if resources.site_states %}
+<script type="application/json" id="site-states">{{ resources.site_states }}</script>
+<script src="%(states_js)s"></script>
+{%- endif %}
 <script>
 // the still picture of a 3D view replaces nothing; it appears below the view when
 // the browser has no WebGL, or when the view has drawn no canvas 30 s after loading
 (function () {
+  window.siteRevealStills = reveal;  // the site's browser test runs it without the wait
   function reveal(all) {
     document.querySelectorAll("img.site-still").forEach(function (img) {
       var child = img.closest(".jp-OutputArea-child");
       var view = child && child.previousElementSibling;
-      if (all || !(view && view.querySelector("canvas"))) img.hidden = false;
+      // pythreejs keeps 8 canvases per page: an older view is frozen into an <img> of
+      // its last frame (live again when the mouse enters), which is drawn too
+      var drawn = view && (view.querySelector("canvas") || view.querySelector(".jupyter-widgets img"));
+      if (all || !drawn) img.hidden = false;
     });
   }
   var probe = document.createElement("canvas").getContext("webgl");
@@ -348,7 +456,7 @@ def exporter():
     from jinja2 import DictLoader
     from nbconvert import HTMLExporter
 
-    template = TEMPLATE.replace("%(paths)s", json.dumps(AMD_PATHS))
+    template = TEMPLATE.replace("%(paths)s", json.dumps(AMD_PATHS)).replace("%(states_js)s", STATES_JS)
     return HTMLExporter(
         extra_loaders=[DictLoader({"site.html.j2": template})],
         template_file="site.html.j2",
@@ -394,8 +502,9 @@ li {{ margin: 0.4em 0; }}
 <body>
 <h1>{title}</h1>
 <p>Every notebook of the workbook, run with its default parameters. The 3D views
-turn in the page: drag to orbit, scroll to zoom, right-drag to pan. Sliders and
-other controls recompute only in JupyterLab; here they show their default value.</p>
+turn in the page: drag to orbit, scroll to zoom, right-drag to pan. The main
+sliders move the views here too: they snap to values computed when the site was
+built. Other controls recompute only in JupyterLab; here they show their default value.</p>
 <ol>
 {items}
 </ol>
@@ -406,7 +515,7 @@ other controls recompute only in JupyterLab; here they show their default value.
 
 def build(out=OUT, names=None, log=print):
     """Build the site into ``out``; returns a list of pages (file, title, live views,
-    seconds, cell errors); the list is also written to ``out/pages.json``."""
+    live sliders, bytes, seconds, cell errors); the list is also written to ``out/pages.json``."""
     out = Path(out)
     paths = [NOTEBOOKS / Path(n).name for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
     if out.exists() and any(out.iterdir()):
@@ -417,35 +526,51 @@ def build(out=OUT, names=None, log=print):
         shutil.rmtree(out)
     out.mkdir(parents=True, exist_ok=True)
     install_assets(out)
+    (out / STATES_JS).parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(Path(__file__).with_name("site_states.js"), out / STATES_JS)
     pages = []
     executed = []
     for path in paths:
         start = time.perf_counter()
         log(f"executing {path.name} ...")
-        nb = execute(path)
-        live = prepare_for_site(nb)
+        nb, recorded = execute(path)
+        live = prepare_for_site(nb, recorded)
+        sliders = [s for r in recorded.values() for s in r.get("sliders", [])]
         pages.append(
             {
                 "file": path.stem + ".html",
                 "title": title_of(nb, path.stem),
                 "views": live,
+                "sliders": [
+                    {"model_id": s["model_id"], "description": s["description"], "states": len(s["values"])}
+                    for s in sliders
+                ],
+                "left_out": [s for r in recorded.values() for s in r.get("left_out", [])],
                 "seconds": round(time.perf_counter() - start, 1),
-                "errors": cell_errors(nb),
+                "errors": cell_errors(nb)
+                + [f"cell {i}: recording its sliders: {r['error']}" for i, r in recorded.items() if "error" in r],
             }
         )
-        executed.append(nb)
-        log(f"  {pages[-1]['seconds']} s, {live} live 3D views")
+        executed.append((nb, page_states(recorded)))
+        log(f"  {pages[-1]['seconds']} s, {live} live 3D views, {len(sliders)} precomputed sliders")
+        for s in sliders:
+            log(f"    {s['description']}: {len(s['values'])} states")
+        for s in pages[-1]["left_out"]:
+            log(f"    {s['description']}: not precomputed ({s['reason']})")
         for error in pages[-1]["errors"]:
             log(f"  ERROR in {error}")
     page_exporter = exporter()
-    for i, (page, nb) in enumerate(zip(pages, executed)):
-        body, _ = page_exporter.from_notebook_node(
-            nb, resources={"site_nav": nav_html(pages, i), "metadata": {"name": page["title"]}}
-        )
+    for i, (page, (nb, states)) in enumerate(zip(pages, executed)):
+        resources = {"site_nav": nav_html(pages, i), "metadata": {"name": page["title"]}}
+        if states:  # JSON inside <script>: "</" written as "<\/" so no text in it ends the element
+            resources["site_states"] = json.dumps(states, separators=(",", ":")).replace("</", "<\\/")
+        body, _ = page_exporter.from_notebook_node(nb, resources=resources)
         (out / page["file"]).write_text(body, encoding="utf-8")
+        page["bytes"] = (out / page["file"]).stat().st_size
     items = "\n".join(
         f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
-        f'<span class="views">({p["views"]} live 3D view{"" if p["views"] == 1 else "s"})</span></li>'
+        f'<span class="views">({p["views"]} live 3D view{"" if p["views"] == 1 else "s"}'
+        f"{live_sliders_text(len(p['sliders']))})</span></li>"
         for p in pages
     )
     (out / "index.html").write_text(
@@ -453,6 +578,10 @@ def build(out=OUT, names=None, log=print):
     )
     (out / "pages.json").write_text(json.dumps(pages, indent=1))
     return pages
+
+
+def live_sliders_text(n):
+    return "" if not n else f", {n} slider{'' if n == 1 else 's'} that move{'s' if n == 1 else ''} the view"
 
 
 def folder_size(path):
@@ -470,7 +599,10 @@ def main(argv=None):
     print(f"\nbuilt {args.out} in {time.perf_counter() - start:.0f} s, {size / 1e6:.1f} MB:")
     for p in pages:
         errors = f", {len(p['errors'])} cell errors" if p["errors"] else ""
-        print(f"  {p['file']:45s} {p['views']:2d} live 3D views{errors}")
+        print(
+            f"  {p['file']:45s} {p['bytes'] / 1e6:5.1f} MB, {p['views']:2d} live 3D views, "
+            f"{len(p['sliders'])} live controls{errors}"
+        )
     print(f"open {Path(args.out) / 'index.html'} in a browser, or copy the folder to any static web host")
     failed = [p["file"] for p in pages if p["errors"]]
     if failed:

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..mesh.errors import MeshError
-from ..mesh.geometry import bounding_box_diagonal, enclosed_volume, face_cross, mean_edge_length, surface_area
+from ..mesh.geometry import bounding_box_diagonal, cross, enclosed_volume, face_cross, mean_edge_length, surface_area
 from ..mesh.topology import Topology
 from ..mesh.validate import as_faces, as_vertices
 
@@ -242,7 +242,7 @@ class _SurfaceIndex:
         is no larger than the largest exact distance found: no point left can
         exceed it."""
         P = np.asarray(P, dtype=np.float64)
-        _, nearest = self.tree.query(P, k=1)
+        _, nearest = self.tree.query(P, k=1, workers=-1)  # every point: both cores
         u = point_triangle_distance(P, self.A[nearest], self.B[nearest], self.C[nearest])
         order = np.argsort(-u, kind="stable")
         best = 0.0
@@ -379,8 +379,9 @@ class MeshComparison:
         return V
 
     def vertex_rms(self, V, relative=True):
-        """:func:`vertex_rms` against the clean mesh."""
-        return vertex_rms(self._check(V), self.V_clean, relative)
+        """:func:`vertex_rms` against the clean mesh (relative: over the diagonal computed once)."""
+        rms = vertex_rms(self._check(V), self.V_clean, relative=False)
+        return rms / self.diagonal if relative else rms
 
     def face_normal_angles(self, V):
         """:func:`face_normal_angles` against the clean mesh, (m,) degrees."""
@@ -436,14 +437,15 @@ class MeshComparison:
 
 def _angles(a, b):
     """Angles (degrees, 0..180) between the rows of a and b: arctan2(|a x b|, a . b), exact near 0 and 180."""
-    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b)))
+    sine = np.sqrt((cross(a.T, b.T) ** 2).sum(axis=0))  # |a x b| on coordinate rows: several times np.cross's speed
+    return np.degrees(np.arctan2(sine, np.einsum("ij,ij->i", a, b)))
 
 
 def _normal_angles(N, N_clean):
     """Angles (degrees) between the rows of two arrays of (unnormalised)
     normals; rows with a zero vector (degenerate faces) count as 90."""
     angle = _angles(N, N_clean)
-    zero = (np.linalg.norm(N, axis=1) == 0) | (np.linalg.norm(N_clean, axis=1) == 0)
+    zero = ~N.any(axis=1) | ~N_clean.any(axis=1)
     angle[zero] = 90.0
     return angle
 

@@ -183,6 +183,12 @@ class ParametricSurface:
     check_values : dict, optional
         Admissible numbers for ``params`` used to check the normal hint at
         random points (torus: R > r).
+    simplify : bool
+        False: derive without simplifying each step (the cancellations that
+        keep the poles finite still happen). The expressions are longer but
+        their values the same, to rounding: for surfaces that are only
+        evaluated (``lambdify``), as the test meshes' exact curvature is; the
+        derivation then takes a fifth of the time or less.
     """
 
     def __init__(
@@ -200,6 +206,7 @@ class ParametricSurface:
         name="surface",
         closed=False,
         check_values=None,
+        simplify=True,
         _family=None,
     ):
         if orientation not in (1, -1):
@@ -215,6 +222,7 @@ class ParametricSurface:
         self.orientation = orientation
         self._cache = {}
         self._lambdified = {}
+        self.simplify = simplify if _family is None else _family.simplify
         if _family is not None:
             # A member of a family: symbolic results come from the family by substitution.
             self._family = _family
@@ -285,6 +293,10 @@ class ParametricSurface:
                 self._cache[key] = compute()
         return self._cache[key]
 
+    def _simplified(self, expr):
+        """``_tidy(expr)``, or expr as it is on a surface made with ``simplify=False``."""
+        return _tidy(expr) if self.simplify else sp.sympify(expr)
+
     def _substitute(self, val):
         return _subs_tidy(val, self.values)
 
@@ -302,17 +314,17 @@ class ParametricSurface:
 
     def derive_first_fundamental_form(self):
         pu, pv = self.tangents()
-        E, F, G = (_tidy(x) for x in (pu.dot(pu), pu.dot(pv), pv.dot(pv)))
+        E, F, G = (self._simplified(x) for x in (pu.dot(pu), pu.dot(pv), pv.dot(pv)))
         return sp.Matrix([[E, F], [F, G]])
 
     def derive_normal_parts(self):
         """(D, D.D, area_factor): n = D/|D|, p_u x p_v = orientation * area_factor * D."""
         if self._D is None:
             pu, pv = self.tangents()
-            D = (self.orientation * pu.cross(pv)).applyfunc(_tidy)
-            return D, _tidy(D.dot(D)), sp.Integer(1)
-        D = self._D.applyfunc(_tidy)
-        return D, _tidy(D.dot(D)), self._area_factor
+            D = (self.orientation * pu.cross(pv)).applyfunc(self._simplified)
+            return D, self._simplified(D.dot(D)), sp.Integer(1)
+        D = self._D.applyfunc(self._simplified)
+        return D, self._simplified(D.dot(D)), self._area_factor
 
     def derive_unit_normal(self):
         D, DD, _ = self._normal_parts()
@@ -322,7 +334,7 @@ class ParametricSurface:
         """(e_n, f_n, g_n) = -(p_uu, p_uv, p_vv) . D: the second form times |D| (normal -n)."""
         D, _, _ = self._normal_parts()
         p, u, v = self.p, self.u, self.v
-        return tuple(_tidy(-_dot(p.diff(x, y), D)) for x, y in ((u, u), (u, v), (v, v)))
+        return tuple(self._simplified(-_dot(p.diff(x, y), D)) for x, y in ((u, u), (u, v), (v, v)))
 
     def derive_second_fundamental_form(self):
         en, fn, gn = self._second_numerators()
@@ -336,8 +348,8 @@ class ParametricSurface:
         _, DD, af = self._normal_parts()
         I = self.first_fundamental_form()
         E, F, G = I[0, 0], I[0, 1], I[1, 1]
-        k_num = _tidy(sp.cancel((en * gn - fn**2) / af**2))
-        h_num = _tidy(sp.cancel((en * G - 2 * fn * F + gn * E) / af**2))
+        k_num = self._simplified(sp.cancel((en * gn - fn**2) / af**2))
+        h_num = self._simplified(sp.cancel((en * G - 2 * fn * F + gn * E) / af**2))
         return (k_num, h_num)
 
     def derive_gaussian_curvature(self):
@@ -354,7 +366,7 @@ class ParametricSurface:
         # k = H +- sqrt(H^2 - K) = (h_num +- sqrt(h_num^2 - 4 k_num W^2)) / (2 W^3)
         k_num, h_num = self._get("curvature_numerators", self.derive_curvature_numerators)
         _, DD, _ = self._normal_parts()
-        root = sp.sqrt(_tidy(h_num**2 - 4 * k_num * DD))
+        root = sp.sqrt(self._simplified(h_num**2 - 4 * k_num * DD))
         den = 2 * DD ** sp.Rational(3, 2)
         return ((h_num + root) / den, (h_num - root) / den)
 
@@ -363,7 +375,7 @@ class ParametricSurface:
         _, DD, af = self._normal_parts()
         I = self.first_fundamental_form()
         num = I.adjugate() * sp.Matrix([[en, fn], [fn, gn]])
-        return num.applyfunc(lambda x: _tidy(sp.cancel(x / af**2))) / DD ** sp.Rational(3, 2)
+        return num.applyfunc(lambda x: self._simplified(sp.cancel(x / af**2))) / DD ** sp.Rational(3, 2)
 
     def derive_area_element(self):
         _, DD, af = self._normal_parts()
@@ -376,7 +388,7 @@ class ParametricSurface:
         E, F = I[0, 0], I[0, 1]
         _, DD, af = self._normal_parts()
         e1 = pu / sp.sqrt(E)
-        wn = (E * pv - F * pu).applyfunc(lambda x: _tidy(sp.cancel(x / af)))
+        wn = (E * pv - F * pu).applyfunc(lambda x: self._simplified(sp.cancel(x / af)))
         return (e1, wn / (sp.sqrt(E) * sp.sqrt(DD)))
 
     def derive_frame_coefficients(self):
@@ -390,9 +402,9 @@ class ParametricSurface:
         I = self.first_fundamental_form()
         E, F = I[0, 0], I[0, 1]
         W = sp.sqrt(DD)
-        A = _tidy(sp.cancel(en / E)) / W
-        B = _tidy(sp.cancel((fn * E - en * F) / (E * af))) / DD
-        C = _tidy(sp.cancel((en * F**2 - 2 * fn * F * E + gn * E**2) / (E * af**2))) / W**3
+        A = self._simplified(sp.cancel(en / E)) / W
+        B = self._simplified(sp.cancel((fn * E - en * F) / (E * af))) / DD
+        C = self._simplified(sp.cancel((en * F**2 - 2 * fn * F * E + gn * E**2) / (E * af**2))) / W**3
         return (A, B, C)
 
     # ------------------------------------------------------ public, symbolic
@@ -688,7 +700,7 @@ _U, _V = sp.symbols("u v", real=True)
 
 
 @functools.lru_cache(maxsize=None)
-def _ellipsoid_family():
+def _ellipsoid_family(simplify=True):
     a, b, c = sp.symbols("a b c", positive=True)
     u, v = _U, _V
     p = (a * sp.cos(u) * sp.sin(v), b * sp.sin(u) * sp.sin(v), c * sp.cos(v))
@@ -705,6 +717,7 @@ def _ellipsoid_family():
         domain=((0, 2 * sp.pi), (0, sp.pi)),
         name="ellipsoid",
         closed=True,
+        simplify=simplify,
     )
 
 
@@ -733,7 +746,7 @@ def _specialised(family, values):
     )
 
 
-def ellipsoid(a, b, c):
+def ellipsoid(a, b, c, simplify=True):
     """Ellipsoid p(u, v) = (a cos u sin v, b sin u sin v, c cos v), u in [0, 2 pi), v in [0, pi].
 
     ``a, b, c`` > 0 are numbers or sympy expressions (assumed positive). The
@@ -744,7 +757,7 @@ def ellipsoid(a, b, c):
     the +z axis (v = 0 north pole, where p_u = 0: the parameterisation is
     singular at v = 0 and v = pi).
     """
-    return _member(_ellipsoid_family(), (a, b, c))
+    return _member(_ellipsoid_family(simplify), (a, b, c))
 
 
 def ellipsoid_forms(a, b, c, u, v):
@@ -798,7 +811,7 @@ def sphere(r=1):
 
 
 @functools.lru_cache(maxsize=None)
-def _torus_family():
+def _torus_family(simplify=True):
     R, r = sp.symbols("R r", positive=True)
     u, v = _U, _V
     rho = R + r * sp.cos(v)
@@ -816,10 +829,11 @@ def _torus_family():
         name="torus",
         closed=True,
         check_values={R: 2.0, r: 0.7},
+        simplify=simplify,
     )
 
 
-def torus(R=2, r=sp.Rational(1, 2)):
+def torus(R=2, r=sp.Rational(1, 2), simplify=True):
     """Torus ((R + r cos v) cos u, (R + r cos v) sin u, r sin v), R > r > 0, u, v in [0, 2 pi).
 
     p_u x p_v = r (R + r cos v) (cos u cos v, sin u cos v, sin v) is outward.
@@ -829,7 +843,7 @@ def torus(R=2, r=sp.Rational(1, 2)):
     Rv, rv = _exact(R), _exact(r)
     if Rv.is_number and rv.is_number and not (Rv > rv):
         raise ValueError(f"torus needs R > r (a ring torus), got R={R}, r={r}")
-    return _member(_torus_family(), (Rv, rv))
+    return _member(_torus_family(simplify), (Rv, rv))
 
 
 @functools.lru_cache(maxsize=None)
@@ -848,7 +862,7 @@ def helicoid(c=1):
     return _member(_helicoid_family(), (c,))
 
 
-def monge(h, x=None, y=None, domain=((-1, 1), (-1, 1)), name="monge patch"):
+def monge(h, x=None, y=None, domain=((-1, 1), (-1, 1)), name="monge patch", simplify=True):
     """Monge patch p(x, y) = (x, y, h(x, y)) (the graph of h; x, y are the parameters u, v).
 
     Open; the unit normal is the upward one, n = (-h_x, -h_y, 1)/sqrt(1 + h_x^2 + h_y^2)
@@ -864,7 +878,7 @@ def monge(h, x=None, y=None, domain=((-1, 1), (-1, 1)), name="monge patch"):
         names = {s.name: s for s in h.free_symbols}
         x = x if x is not None else names.get("x", sp.Symbol("x", real=True))
         y = y if y is not None else names.get("y", sp.Symbol("y", real=True))
-    return ParametricSurface((x, y, h), x, y, domain=domain, name=name, closed=False)
+    return ParametricSurface((x, y, h), x, y, domain=domain, name=name, closed=False, simplify=simplify)
 
 
 def saddle(k=1):

@@ -29,7 +29,7 @@ import warnings
 
 from ..mesh.errors import MeshError, MeshWarning
 from .stills import png_base64
-from .viewer import MeshView, ViewRow, box_still
+from .viewer import MeshView, ViewRow, box_still, stills_only
 
 __all__ = ["live", "Live", "mesh_warnings"]
 
@@ -85,7 +85,8 @@ class Live:
         self.readout.value = "<code>" + "<br>".join(html.escape(line) for line in lines) + "</code>"
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        # while nbgrader runs the notebook its feedback page is static HTML: the still and the read-out only
+        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         still = box_still(self.widget)
         if still is not None:
             bundle["image/png"] = png_base64(still)

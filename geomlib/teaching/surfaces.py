@@ -327,21 +327,22 @@ def _exact_number(x):
 @functools.lru_cache(maxsize=32)
 def _symbolic_surface(kind, params):
     """The geomlib.lessons.symbolic surface for ("ellipsoid", (a, b, c)), ("torus", (R, r))
-    or ("saddle", (A, B)), made once per parameter set and process."""
+    or ("saddle", (A, B)), made once per parameter set and process. Only evaluated, never shown:
+    derived without simplifying (the same values, a fraction of the time)."""
     import sympy as sp
 
     from ..lessons import symbolic
 
     if kind == "ellipsoid":
-        return symbolic.ellipsoid(*params)
+        return symbolic.ellipsoid(*params, simplify=False)
     if kind == "torus":
-        return symbolic.torus(*params)
+        return symbolic.torus(*params, simplify=False)
     if kind == "saddle":
         A, B = (_exact_number(t) for t in params)
         x, y = sp.symbols("x y", real=True)
-        # a polynomial: sympy simplifies its curvature quickly and reliably
+        # a polynomial, so its curvature needs no simplification to stay finite
         h = A * sp.Rational(27, 4) * x * (1 - x**2) * y * (1 - y**2) + B * (x**3 - 3 * x * y**2)
-        return symbolic.monge(h, x, y, name="saddle")
+        return symbolic.monge(h, x, y, name="saddle", simplify=False)
     raise MeshError(f"no symbolic surface {kind!r}")  # pragma: no cover
 
 

@@ -15,10 +15,17 @@ On every page:
    (without WebGL, the still pictures are shown instead: a separate test);
 4. the formulas are typeset by the MathJax served from the site: MathJax
    output is present, no TeX error, no ``$$`` left in the text;
-5. every control that needs a kernel is disabled, and a note says so; widget labels use
+5. every control that needs a kernel is disabled, and a note says so; the sliders whose
+   states the build recorded are enabled, with a note that they snap; widget labels use
    JupyterLab's interface font (not the browser's default serif);
-6. no console error and no uncaught exception;
-7. no cell raised an error while the notebook ran for the site.
+6. no still picture shows beside a live view that drew (the stills are for browsers
+   without WebGL, and for pythreejs' frozen views, which are drawn too);
+7. no console error and no uncaught exception;
+8. no cell raised an error while the notebook ran for the site.
+
+On the pages with precomputed sliders (01, 04, 05, 06, 07; the ones the course needs are
+listed in LIVE_SLIDERS), every such slider, moved with the keyboard, changes its
+cell's 3D view and read-out, and moved back restores the first picture exactly.
 
 The index lists every notebook in reading order, and a page opened from
 ``file://`` works the same way (canvases drawn, nothing fetched from outside).
@@ -49,6 +56,15 @@ LOAD_TIMEOUT = 90  # seconds for a page's views and formulas to appear
 LOCAL_SCHEMES = ("file:", "data:", "blob:")
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
+#: sliders that must move their views on the site (their descriptions), per page
+LIVE_SLIDERS = {
+    "01_uniform_laplace_curvature.html": {"jitter"},
+    "04_spectral_reconstruction.html": {"i", "k"},
+    "05_explicit_smoothing.html": {"τ / ℓ²", "iterations"},
+    "06_implicit_smoothing.html": {"τ / ℓ²", "iterations"},
+    "07_denoising_evaluation.html": {"sigma", "iterations"},
+}
 
 
 @pytest.fixture(scope="session")
@@ -145,7 +161,34 @@ JS_CONTROLS = r"""
   const fonts = new Set(labels.map(el => bare(getComputedStyle(el).fontFamily)));
   return {controls: sliders.length, enabled: enabled.length,
           notes: document.querySelectorAll('.site-kernel-note').length,
+          snap_notes: document.querySelectorAll('.site-snap-note').length,
           ui: ui, fonts: Array.from(fonts), labels: labels.length};
+}
+"""
+
+
+# run the page's own check that reveals a still where its view did not draw (normally
+# 30 s after loading); the number of stills then shown
+JS_SHOWN_STILLS = """
+() => Array.from(document.querySelectorAll('img.site-still')).filter(img => img.getClientRects().length > 0).length
+"""
+JS_REVEAL_STILLS = "() => { window.siteRevealStills(false); return (" + JS_SHOWN_STILLS + ")(); }"
+
+# mark the element of every precomputed slider (data-site-slider = its model id) and
+# its cell's output area (data-site-cell-<model id>); the sliders' descriptions, values and default
+JS_MARK_SLIDERS = """
+async () => {
+  const out = [];
+  for (const group of window.siteStates) {
+    for (const s of group.sliders) {
+      const views = await Promise.all(Object.values(s.model.views));
+      const el = views.map(v => v.el).find(el => el.isConnected);
+      el.setAttribute('data-site-slider', s.model_id);
+      el.closest('.jp-OutputArea-output').setAttribute('data-site-cell-' + s.model_id, '');  // a cell has several
+      out.push({id: s.model_id, description: s.description, values: s.values, default: s.default});
+    }
+  }
+  return out;
 }
 """
 
@@ -214,10 +257,17 @@ def test_page_offline(notebook, site, site_url, browser):
 
         _check_canvases(page, pages[name]["views"], shots)
 
+        assert page.evaluate(JS_REVEAL_STILLS) == 0, "still pictures shown beside 3D views that drew"  # issue 23
+
         controls = page.evaluate(JS_CONTROLS)
-        assert controls["enabled"] == 0, f"{controls['enabled']} controls look usable without a kernel"
-        if controls["controls"]:
+        live = len(pages[name]["sliders"])
+        assert controls["enabled"] == live, (
+            f"{controls['enabled']} controls usable without a kernel, {live} precomputed"
+        )
+        if controls["controls"] > live:
             assert controls["notes"] > 0, "controls are shown without the note that they need JupyterLab"
+        if live:
+            assert controls["snap_notes"] > 0, "precomputed sliders are shown without the note that they snap"
         if controls["labels"]:  # widget text in JupyterLab's interface font, as in the workbook itself
             assert controls["ui"], "the page does not define JupyterLab's --jp-ui-font-family"
             assert controls["fonts"] == [controls["ui"]], f"widget labels in {controls['fonts']}, not {controls['ui']}"
@@ -291,11 +341,85 @@ def test_stills_show_without_webgl(site, site_url, browser):
         view.page.goto(site_url + name, wait_until="load")
         stills = view.page.locator("img.site-still")
         assert stills.count() > 0, "the page holds no still pictures of its views"
-        assert lablib.wait_for(
-            lambda: view.page.locator("img.site-still:not([hidden])").count() == stills.count(), 30
-        ), f"{view.page.locator('img.site-still:not([hidden])').count()} of {stills.count()} stills shown"
+        assert lablib.wait_for(lambda: view.page.evaluate(JS_SHOWN_STILLS) == stills.count(), 30), (
+            f"{view.page.evaluate(JS_SHOWN_STILLS)} of {stills.count()} stills shown"
+        )
         for i in range(stills.count()):
             assert _not_blank(lablib.stable_screenshot(stills.nth(i))), f"still {i} is blank"
         assert not view.outside, f"requests to the network: {view.outside}"
+    finally:
+        view.close()
+
+
+def _pictures(canvases, drawn=lambda png: True):
+    """Screenshots of the cell's canvases, each ``drawn`` (a frozen view comes back when hovered).
+    A moved state may be nearly empty: a large implicit step collapses the mesh to a speck."""
+    shots = []
+    for i in range(canvases.count()):
+        canvas = canvases.nth(i)
+        canvas.scroll_into_view_if_needed()
+        canvas.hover()
+        png = lablib.wait_for(lambda canvas=canvas: _shot_if(canvas, drawn), 30)
+        assert png, f"canvas {i} of the slider's cell stays blank"
+        shots.append(png)
+    return shots
+
+
+def _press(page, handle, key, slider_id, index):
+    handle.press(key)
+    at = f"() => window.siteStates.flatMap(g => g.sliders).find(s => s.model_id === '{slider_id}').current"
+    assert lablib.wait_for(lambda: page.evaluate(at) == index, 20), f"{key}: the slider is at state {page.evaluate(at)}"
+
+
+@pytest.mark.parametrize("name", sorted(LIVE_SLIDERS))
+def test_precomputed_sliders_move_the_views(name, site, site_url, browser):
+    """Every precomputed slider: moved, its cell's view and read-out change; moved back, the
+    first picture and text return exactly. Offline, no console error."""
+    _, pages = site
+    assert name in pages, f"{name} was not built"
+    recorded = {s["description"] for s in pages[name]["sliders"]}
+    assert LIVE_SLIDERS[name] <= recorded, f"not precomputed: {LIVE_SLIDERS[name] - recorded}"
+    shots = SCREENSHOTS / (Path(name).stem + "-sliders")
+    shots.mkdir(parents=True, exist_ok=True)
+    view = OfflinePage(browser, site_url)
+    try:
+        page = view.page
+        page.goto(site_url + name, wait_until="load")
+        ready = "() => document.body.getAttribute('data-site-states')"
+        assert lablib.wait_for(lambda: page.evaluate(ready) == "ready", LOAD_TIMEOUT), "the sliders were not wired"
+        sliders = page.evaluate(JS_MARK_SLIDERS)
+        assert len(sliders) == len(pages[name]["sliders"])
+        for s in sliders:
+            cell = page.locator(f"[data-site-cell-{s['id']}]")
+            canvases = cell.locator("canvas")
+            assert lablib.wait_for(lambda: canvases.count() > 0, LOAD_TIMEOUT), f"{s['description']}: no view"
+            before, text = _pictures(canvases, _not_blank), cell.inner_text()
+            handle = page.locator(f'[data-site-slider="{s["id"]}"] .noUi-handle')
+            handle.focus()
+            last, d = len(s["values"]) - 1, s["default"]
+            far, key, back = (last, "End", "ArrowLeft") if d < last else (0, "Home", "ArrowRight")
+            _press(page, handle, key, s["id"], far)
+            moved = lablib.wait_for(
+                lambda: max(lablib.changed_fraction(a, b) for a, b in zip(before, _pictures(canvases))) > 0.002, 20
+            )
+            assert moved, f"{s['description']} moved to {s['values'][far]}: its view did not change"
+            assert cell.inner_text() != text, f"{s['description']} moved: its read-out did not change"
+            for i, png in enumerate(_pictures(canvases)):
+                (shots / f"{s['description'].replace('/', '')}-{i}-moved.png").write_bytes(png)
+            for j in range(abs(far - d)):  # one computed value per key press, back to the default
+                _press(page, handle, back, s["id"], far - j - 1 if far > d else far + j + 1)
+            after = lablib.wait_for(
+                lambda: (
+                    (now := _pictures(canvases))
+                    and all(lablib.changed_fraction(a, b) == 0 for a, b in zip(before, now))
+                    and now
+                ),
+                20,
+            )
+            assert after, f"{s['description']} moved back: the first picture did not return"
+            assert cell.inner_text() == text, f"{s['description']} moved back: the read-out differs"
+        assert not view.outside, f"requests to the network: {view.outside}"
+        assert not view.missing, f"files missing from the site: {view.missing}"
+        assert not view.errors, "console errors:\n" + "\n".join(view.errors)
     finally:
         view.close()

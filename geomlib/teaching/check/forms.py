@@ -3,10 +3,13 @@
 The learner's expressions are compared by value, at a few points of the
 parameter domain and a few semi-axes, so an unsimplified but correct
 expression passes: simplification is a matter of taste, not a mistake.
+
+sympy is imported inside the checks that use it: it takes about a second to
+import, and every notebook imports ``geomlib.check``, most of them without a
+symbolic exercise.
 """
 
 import numpy as np
-import sympy as sp
 
 from .result import Mistake, call, exercise
 
@@ -19,6 +22,8 @@ _NAMES = ("E", "F", "G", "e", "f", "g")
 
 def _expressions(out):
     """The six expressions (E, F, G, e, f, g) from a 6-tuple or from the pair of 2x2 matrices (I, II)."""
+    import sympy as sp
+
     if isinstance(out, (tuple, list)) and len(out) == 6:
         return [sp.sympify(x) for x in out]
     if isinstance(out, (tuple, list)) and len(out) == 2:
@@ -44,6 +49,8 @@ def _expressions(out):
 
 def _values(exprs, symbols, points):
     """(6, len(points)) float array of the expressions at the points (a, b, c, u, v)."""
+    import sympy as sp
+
     extra = set().union(*(x.free_symbols for x in exprs)) - set(symbols)
     if extra:
         raise Mistake(
@@ -88,6 +95,8 @@ def _same(x, y):
 )
 def fundamental_forms(fn):
     """Check ``fn(a, b, c, u, v) -> (E, F, G, e, f, g)`` (or ``(I, II)``) for the ellipsoid, by value."""
+    import sympy as sp
+
     a, b, c = sp.symbols("a b c", positive=True)
     u, v = sp.symbols("u v", real=True)
     exprs = _expressions(call(fn, a, b, c, u, v))
