@@ -17,7 +17,10 @@
   ``benchmarks/bench_spectral.py`` against ``eigsh`` with one BLAS thread
   (2 cores shared with other work, load average 3-6, one run each): 0.59x at
   10k vertices, k = 50; 0.32x at 10k and 40k, k = 200; 0.26x at 160k, k = 200
-  (37 s against 139 s); with the orthogonalisation still written as
+  (37 s against 139 s); in the saved run on a quiet machine (load average
+  1.0-1.4) 0.65x, 0.29x, 0.37x, 0.25x, 0.36x and 0.25x at 10k, 40k and 160k
+  vertices for k = 50 and 200 (0.06x to 0.41x against the default two
+  threads); with the orthogonalisation still written as
   ``(n, j) @ (j, b)``, 0.34x at 40k and 0.32x at 160k for k = 50. The new
   block is kept as rows, ``(b, n)``: at 160k vertices ``W @ Q`` and
   ``(W @ Q) @ Q.T`` read the basis at memory speed, ``Q @ h`` three to four
