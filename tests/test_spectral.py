@@ -63,7 +63,7 @@ def _rel_error(V, Vk, m):
 @pytest.mark.parametrize("method", ["dense", "sparse"])
 def test_m_orthonormal_and_residual(egg, method):
     V, F = egg
-    lam, E = eigenbasis(V, F, 40, method=method, cache=False)
+    lam, E = eigenbasis(V, F, 40, method=method)
     m, C = _mass(V, F)
     assert E.shape == (len(V), 40) and lam.shape == (40,)
     assert np.abs(E.T @ (m[:, None] * E) - np.eye(40)).max() < 1e-8
@@ -77,7 +77,7 @@ def test_m_orthonormal_and_residual(egg, method):
 
 def test_first_eigenvector_is_the_constant(egg):
     V, F = egg
-    lam, E = eigenbasis(V, F, 5, cache=False)
+    lam, E = eigenbasis(V, F, 5)
     m, _ = _mass(V, F)
     assert lam[0] == 0.0
     np.testing.assert_allclose(E[:, 0], 1.0 / np.sqrt(m.sum()), rtol=1e-12)
@@ -86,8 +86,8 @@ def test_first_eigenvector_is_the_constant(egg):
 @pytest.mark.parametrize("method", ["sparse", "arpack"])
 def test_dense_and_sparse_agree(egg, method):
     V, F = egg
-    ld, Ed = eigenbasis(V, F, 30, method="dense", cache=False)
-    ls, Es = eigenbasis(V, F, 30, method=method, cache=False)
+    ld, Ed = eigenbasis(V, F, 30, method="dense")
+    ls, Es = eigenbasis(V, F, 30, method=method)
     np.testing.assert_allclose(ls, ld, rtol=1e-9, atol=1e-9)
     # simple eigenvalues here, and the sign convention fixes each vector
     m, _ = _mass(V, F)
@@ -119,7 +119,7 @@ def test_smallest_eigenpairs_of_a_known_spectrum():
 def test_unit_sphere_eigenvalues_are_l_l_plus_1():
     """Spherical harmonics: lam = l (l + 1), multiplicity 2 l + 1, the first 25 within 1%."""
     S = sphere(1.0, subdivisions=4)  # 2562 vertices
-    lam, E = eigenbasis(S.V, S.F, 25, cache=False)
+    lam, E = eigenbasis(S.V, S.F, 25)
     l = np.repeat(np.arange(5), 2 * np.arange(5) + 1)
     exact = l * (l + 1.0)
     assert lam[0] == 0.0
@@ -130,13 +130,13 @@ def test_unit_sphere_eigenvalues_are_l_l_plus_1():
     assert np.bincount(nearest).tolist() == [1, 3, 5, 7, 9]
     # refining the mesh brings them closer (second order in the edge length)
     C3 = sphere(1.0, subdivisions=3)
-    coarse, _ = eigenbasis(C3.V, C3.F, 25, cache=False)
+    coarse, _ = eigenbasis(C3.V, C3.F, 25)
     assert np.abs(coarse[1:] / exact[1:] - 1.0).max() > 2.5 * rel.max()
 
 
 def test_the_l1_eigenvectors_are_the_coordinates():
     S = sphere(1.0, subdivisions=3)
-    lam, E = eigenbasis(S.V, S.F, 4, cache=False)
+    lam, E = eigenbasis(S.V, S.F, 4)
     m, _ = _mass(S.V, S.F)
     # x, y, z lie in the span of e_1, e_2, e_3 (to discretisation error)
     P = E[:, 1:4] @ (E[:, 1:4].T @ (m[:, None] * S.V))
@@ -149,26 +149,26 @@ def test_the_l1_eigenvectors_are_the_coordinates():
 
 def test_scaling_and_rigid_motion(egg):
     V, F = egg
-    lam, E = eigenbasis(V, F, 12, cache=False)
+    lam, E = eigenbasis(V, F, 12)
     s = 2.5
-    lam_s, E_s = eigenbasis(s * V, F, 12, cache=False)
+    lam_s, E_s = eigenbasis(s * V, F, 12)
     np.testing.assert_allclose(lam_s, lam / s**2, rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(E_s, E / s, rtol=1e-7, atol=1e-9)
     rng = np.random.default_rng(3)
     Q, _ = np.linalg.qr(rng.standard_normal((3, 3)))
-    lam_r, _ = eigenbasis(V @ Q.T + [1.0, -2.0, 0.5], F, 12, cache=False)
+    lam_r, _ = eigenbasis(V @ Q.T + [1.0, -2.0, 0.5], F, 12)
     np.testing.assert_allclose(lam_r, lam, rtol=1e-9, atol=1e-12)
 
 
 def test_uniform_weights_use_the_valence(egg):
     V, F = egg
-    lam, E = eigenbasis(V, F, 8, weights="uniform", cache=False)
+    lam, E = eigenbasis(V, F, 8, weights="uniform")
     M, C = laplacian(V, F, weights="uniform")
     m = M.diagonal()
     assert np.abs(E.T @ (m[:, None] * E) - np.eye(8)).max() < 1e-8
     assert np.abs(C @ E + (m[:, None] * E) * lam).max() < 1e-9 * np.abs(C).max()
     # the graph Laplacian ignores the geometry: same for any vertex positions
-    lam2, _ = eigenbasis(V * [3.0, 1.0, 0.2], F, 8, weights="uniform", cache=False)
+    lam2, _ = eigenbasis(V * [3.0, 1.0, 0.2], F, 8, weights="uniform")
     np.testing.assert_allclose(lam2, lam, atol=1e-10)
 
 
@@ -195,7 +195,7 @@ def test_reconstruction_with_one_vector_is_the_area_centroid(egg):
 def test_k_equal_n_reproduces_the_mesh():
     P, F = icosphere(1)  # 42 vertices
     V = P * [1.0, 0.8, 0.6]
-    lam, E = eigenbasis(V, F, len(V), cache=False)
+    lam, E = eigenbasis(V, F, len(V))
     m, _ = _mass(V, F)
     assert np.abs(E.T @ (m[:, None] * E) - np.eye(len(V))).max() < 1e-10
     np.testing.assert_allclose(spectral_reconstruction(V, F, len(V), cache=False), V, atol=1e-12)
@@ -233,7 +233,7 @@ def test_several_components_give_several_zero_eigenvalues():
     V = np.vstack([P, 0.5 * P + [3.0, 0.0, 0.0], 0.3 * P - [3.0, 0.0, 0.0]])
     FF = np.vstack([F, F + len(P), F + 2 * len(P)])
     with pytest.warns(MeshWarning, match="3 connected components"):
-        lam, E = eigenbasis(V, FF, 16, cache=False)
+        lam, E = eigenbasis(V, FF, 16)
     m, C = _mass(V, FF)
     assert lam[:3].tolist() == [0.0, 0.0, 0.0] and lam[3] > 1.0
     # indicator functions, the largest component first
@@ -264,7 +264,7 @@ def test_open_mesh_with_boundary():
     """Natural (Neumann) boundary: the flat square's eigenvalues pi^2 (a^2 + b^2) / L^2."""
     L = 2.0
     V, F = _square(40, L)
-    lam, E = eigenbasis(V, F, 10, cache=False)
+    lam, E = eigenbasis(V, F, 10)
     m, C = _mass(V, F)
     assert lam[0] == 0.0 and lam[1] > 0.0
     np.testing.assert_allclose(E[:, 0], 1 / np.sqrt(m.sum()), rtol=1e-12)
@@ -306,7 +306,7 @@ def test_isolated_vertex_is_named(egg):
         match=rf"1 vertices are used by no face \({len(V)}\).*"
         r"geomlib.mesh.repair.remove_unreferenced_vertices\(V, F\)",
     ):
-        eigenbasis(V2, F, 5, cache=False)
+        eigenbasis(V2, F, 5)
     with pytest.raises(MeshError, match="remove_unreferenced_vertices"):
         spectral_reconstruction(V2, F, 5)
 
@@ -318,8 +318,8 @@ def test_bad_method(egg):
 
 def test_sparse_agrees_with_arpack_at_2562_vertices(egg_fine):
     V, F = egg_fine
-    lb, Eb = eigenbasis(V, F, 60, method="sparse", cache=False)
-    la_, Ea = eigenbasis(V, F, 60, method="arpack", cache=False)
+    lb, Eb = eigenbasis(V, F, 60, method="sparse")
+    la_, Ea = eigenbasis(V, F, 60, method="arpack")
     np.testing.assert_allclose(lb, la_, rtol=1e-10, atol=1e-12)
 
 
@@ -341,14 +341,15 @@ def test_cache_round_trip_and_slices(egg_fine, tmp_path):
     assert len(files) == 1 and files[0].name.endswith("-k30.npz")
     # memory: same numbers, no solve
     b2 = spectral_basis(V, F, 30)
-    assert b2.source == "solved" and b2 is b
+    assert b2.source == "memory" and np.shares_memory(b2.E, b.E)
     # disk, as after a kernel restart; a basis with more pairs serves fewer
     basis_cache.forget()
     b3 = spectral_basis(V, F, 12)
     assert b3.source == "disk"
     np.testing.assert_array_equal(b3.E, b.E[:, :12])
-    lam, E = eigenbasis(V, F, 12)
-    np.testing.assert_array_equal(lam, b.lam[:12])
+    lam, E = eigenbasis(V, F, 12)  # the solve itself: no cache behind it
+    assert not list(spectral_cache_dir().glob("*-k12.npz"))
+    np.testing.assert_allclose(lam, b.lam[:12], rtol=1e-9, atol=1e-12)
 
 
 def test_cache_invalidated_by_mesh_and_operator(egg):
@@ -412,7 +413,7 @@ def test_truncated_cache_file_is_solved_again(egg):
     path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     basis_cache.forget()
     with pytest.warns(MeshWarning, match=f"{path.name} is damaged"):
-        lam, E = eigenbasis(V, F, 8)
+        lam = spectral_basis(V, F, 8).lam
     np.testing.assert_allclose(lam, b.lam, rtol=1e-12, atol=1e-12)
 
 
@@ -421,14 +422,14 @@ def test_file_where_the_cache_folder_should_be(egg, tmp_path):
     blocker = tmp_path / "blocked"
     blocker.write_text("a file, not a folder")
     with pytest.warns(MeshWarning, match="could not write the eigenbasis cache"):
-        lam, E = eigenbasis(V, F, 6, cache_dir=blocker)
+        lam = spectral_basis(V, F, 6, cache_dir=blocker).lam
     assert blocker.read_text() == "a file, not a folder"
     spectral_folder = tmp_path / "inner"
     spectral_folder.mkdir()
     (spectral_folder / "spectral").write_text("a file")
     basis_cache.forget()
     with pytest.warns(MeshWarning, match="is a file, not a folder"):
-        lam2, _ = eigenbasis(V, F, 6, cache_dir=spectral_folder)
+        lam2 = spectral_basis(V, F, 6, cache_dir=spectral_folder).lam
     np.testing.assert_array_equal(lam, lam2)
 
 
@@ -441,7 +442,7 @@ def test_unwritable_cache_folder(egg, tmp_path, monkeypatch):
 
     monkeypatch.setattr(basis_cache.np, "savez", refuse)
     with pytest.warns(MeshWarning, match="Permission denied"):
-        lam, E = eigenbasis(V, F, 6, cache_dir=tmp_path / "ro")
+        lam = spectral_basis(V, F, 6, cache_dir=tmp_path / "ro").lam
     assert lam[0] == 0.0 and lam.shape == (6,)
     assert not list((tmp_path / "ro").rglob("*.npz"))
 
@@ -468,8 +469,8 @@ def test_course_armadillo():
     assert len(V) == 361
     with warnings.catch_warnings():
         warnings.simplefilter("error", MeshWarning)  # one component, no degenerate faces
-        ld, Ed = eigenbasis(V, F, 60, method="dense", cache=False)
-    ls, Es = eigenbasis(V, F, 60, method="sparse", cache=False)
+        ld, Ed = eigenbasis(V, F, 60, method="dense")
+    ls, Es = eigenbasis(V, F, 60, method="sparse")
     np.testing.assert_allclose(ls, ld, rtol=1e-8, atol=1e-8)
     m, C = _mass(V, F)
     assert np.abs(Es.T @ (m[:, None] * Es) - np.eye(60)).max() < 1e-8
@@ -484,7 +485,7 @@ def test_blas_thread_setting_is_restored(egg):
     before = [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
     with eigen.one_blas_thread():
         assert all(i["num_threads"] == 1 for i in threadpool_info() if i["user_api"] == "blas")
-    eigenbasis(*egg, 5, cache=False)
+    eigenbasis(*egg, 5)
     assert [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"] == before
 
 
@@ -493,9 +494,64 @@ def test_long_solves_show_their_stages(egg_fine, monkeypatch, capsys):
 
     V, F = egg_fine
     monkeypatch.setattr(progress, "SECONDS", -1.0)  # every solve counts as long
-    eigenbasis(V, F, 20, cache=False, method="sparse")
+    eigenbasis(V, F, 20, method="sparse")
     err = capsys.readouterr().err
     assert "20 eigenpairs (about" in err and "factorising" in err
     monkeypatch.setattr(progress, "SECONDS", 1e9)  # none does
-    eigenbasis(V, F, 20, cache=False, method="sparse")
+    eigenbasis(V, F, 20, method="sparse")
     assert capsys.readouterr().err == ""
+
+
+# --------------------------------------------------------------------------
+# the code shown is the code that runs
+
+
+def test_eigenbasis_is_the_solve_and_the_cache_calls_it(egg_fine, monkeypatch):
+    """spectral_basis and spectral_reconstruction get their basis from eigenbasis, once per mesh."""
+    import inspect
+
+    import geomlib.lessons.spectral as spectral
+
+    assert "cache" not in inspect.signature(eigenbasis).parameters
+    V, F = egg_fine
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(args[2])
+        return eigenbasis(*args, **kwargs)
+
+    monkeypatch.setattr(spectral, "eigenbasis", counted)
+    b = spectral_basis(V, F, 20)
+    spectral_reconstruction(V, F, 12)  # from memory
+    basis_cache.forget()
+    spectral_reconstruction(V, F, 15)  # from disk
+    assert calls == [20] and b.source == "solved"
+
+
+def test_a_wrong_solve_shows_in_the_reconstruction(egg_fine, monkeypatch):
+    """Replace the eigensolver eigenbasis calls by one that skips the smallest eigenpair (the
+    constant): the reconstruction through the cache entry loses the centroid."""
+    import geomlib.lessons.spectral as spectral
+
+    V, F = egg_fine[0] + [2.0, -1.0, 0.5], egg_fine[1]  # the centroid away from the origin
+    m, _ = _mass(V, F)
+    right = _rel_error(V, spectral_reconstruction(V, F, 30, cache=False), m)
+
+    def skipping(S, k, *args):
+        lam, Y = eigen.smallest_eigenpairs(S, k + 1, *args)
+        return lam[1:], Y[:, 1:]
+
+    monkeypatch.setattr(spectral, "smallest_eigenpairs", skipping)
+    V_wrong = spectral_reconstruction(V, F, 30, cache=False)
+    assert right < 0.05 and _rel_error(V, V_wrong, m) > 10 * right
+    np.testing.assert_allclose(m @ V_wrong, 0.0, atol=1e-12)  # no constant: the centroid went to 0
+
+
+def test_lanczos_resolves_repeated_eigenvalues():
+    """A diagonal matrix with a 6-fold smallest non-zero eigenvalue: every copy is found."""
+    import scipy.sparse as sp
+
+    d = np.r_[0.0, np.full(6, 1.0), np.linspace(2.0, 50.0, 2000)]
+    lam, Y = eigen.smallest_eigenpairs(sp.diags(d).tocsr(), 12, 1e-4, "sparse")
+    np.testing.assert_allclose(lam, d[:12], atol=1e-12)
+    assert np.abs(Y.T @ Y - np.eye(12)).max() < 1e-12

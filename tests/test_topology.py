@@ -320,3 +320,24 @@ def test_unreferenced_vertices_and_non_manifold_edges():
     assert unreferenced_vertices(F, 7).tolist() == [4, 6]
     assert non_manifold_edges(F).tolist() == [[0, 1]]
     assert non_manifold_edges(F[:2]).shape == (0, 2)
+
+
+def test_boundary_counts_through_unpaired_vertices_match_the_full_edge_count():
+    """The half-edge probes only skip work: on open, flipped, bow-tie and non-manifold meshes
+    the boundary counts equal those of the full edge table."""
+    from geomlib.mesh.topology import boundary_edge_counts, edge_face_counts, unpaired_vertices
+    from geomlib.teaching.surfaces import icosphere, plane
+
+    _, closed = icosphere(2)
+    grid = plane(n=12).F
+    flipped = grid.copy()
+    flipped[::3] = flipped[::3, ::-1]  # inconsistent orientation: interior edges, unpaired half-edges
+    rng = np.random.default_rng(3)
+    holes = closed[rng.permutation(len(closed))[:-25]]  # an open sphere with holes
+    bowtie = np.array([[0, 1, 2], [0, 3, 4], [0, 5, 6], [1, 2, 7]])
+    fin = np.vstack([closed, [[0, 1, 200]]])  # an edge of three faces
+    assert not unpaired_vertices(closed).any()
+    for F in (closed, grid, flipped, holes, bowtie, fin):
+        E, count = edge_face_counts(F)
+        exact = np.bincount(E[count == 1].ravel(), minlength=F.max() + 1)
+        np.testing.assert_array_equal(boundary_edge_counts(F), exact)

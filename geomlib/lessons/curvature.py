@@ -38,7 +38,7 @@ import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
 from ..mesh.geometry import vertex_normals
-from ..mesh.topology import boundary_edge_counts, edge_face_counts
+from ..mesh.topology import boundary_edge_counts, edges_at_unpaired_vertices
 from ..mesh.validate import as_mesh, check_choice
 from .laplace import check_options, face_geometry, laplacian, vertex_areas
 
@@ -55,6 +55,9 @@ __all__ = [
 ]
 
 BOUNDARY_RULES = ("nan", "zero", "turning", "deficit")
+
+#: Faces per block in :func:`angle_sums` (a few MB of corner angles at a time).
+FACE_BLOCK = 1 << 17
 MEAN_BOUNDARY_RULES = ("formula", "nan", "zero")
 
 
@@ -137,10 +140,16 @@ def corner_angles(V, F):
 
 
 def angle_sums(V, F):
-    """Sum of the triangle angles at each vertex (n,) float64, radians; 0 at unreferenced vertices."""
+    """Sum of the triangle angles at each vertex (n,) float64, radians; 0 at unreferenced vertices.
+
+    Summed block by block of faces, so only one block's corner angles exist at a time.
+    """
     V, F = as_mesh(V, F)
-    theta = corner_angles(V, F)
-    return np.bincount(F.T.ravel(), theta.T.ravel(), minlength=len(V))  # corner by corner: rows are contiguous
+    total = np.zeros(len(V))
+    for start in range(0, len(F), FACE_BLOCK):
+        block = F[start : start + FACE_BLOCK]
+        total += np.bincount(block.T.ravel(), corner_angles(V, block).T.ravel(), minlength=len(V))
+    return total
 
 
 def angle_deficit(V, F):
@@ -201,7 +210,7 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
     V, F = as_mesh(V, F)
     K = angle_deficit(V, F)  # 2 pi - sum theta
     if boundary != "deficit":
-        E, faces_at_edge = edge_face_counts(F, len(V))
+        E, faces_at_edge = edges_at_unpaired_vertices(F, len(V))  # a closed mesh sorts nothing
         b = np.bincount(E[faces_at_edge == 1].ravel(), minlength=len(V))  # boundary edges at each vertex
         on_boundary = b > 0
         if boundary == "turning":

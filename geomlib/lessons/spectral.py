@@ -13,20 +13,20 @@ components has ``c`` zero eigenvalues, one per component, and their
 eigenvectors are the normalised indicator functions of the components
 (largest area first); each component then has its own spectrum.
 
-How it is solved (:func:`eigenbasis`): ``M^-1 C`` is not symmetric, so with
-``D = M^1/2`` the problem becomes ``Q y = lam y``, ``Q = -D^-1 C D^-1``,
-``e = D^-1 y`` (Vallet and Levy 2008), handed to
-:func:`geomlib.numerics.eigen.smallest_eigenpairs` (dense LAPACK for small meshes,
-ARPACK shift-invert Lanczos on one sparse Cholesky factorisation otherwise).
+How it is solved (:func:`eigenbasis`, which solves on every call): ``M^-1 C``
+is not symmetric, so with ``D = M^1/2`` the problem becomes ``Q y = lam y``,
+``Q = -D^-1 C D^-1``, ``e = D^-1 y`` (Vallet and Levy 2008), handed to
+:func:`geomlib.numerics.eigen.smallest_eigenpairs` (dense LAPACK for small
+meshes, block Lanczos on one sparse Cholesky factorisation otherwise).
 
-Cache (:mod:`geomlib.numerics.cache`): a basis is kept in memory (the last few meshes)
-and on disk, so a slider over ``k`` re-projects without solving again and a
-restarted kernel finds it. ``cache=False`` neither reads nor writes it;
-:func:`clear_spectral_cache` empties it; :func:`spectral_cache_dir` says where
-it is.
+Cache (:func:`spectral_basis`, a separate entry that calls :func:`eigenbasis`
+on a miss): a basis is kept in memory (the last few meshes) and on disk
+(:mod:`geomlib.numerics.cache`), so a slider over ``k`` re-projects without
+solving again and a restarted kernel finds it. ``cache=False`` neither reads
+nor writes it; :func:`clear_spectral_cache` empties it;
+:func:`spectral_cache_dir` says where it is.
 """
 
-import hashlib
 import time
 import warnings
 
@@ -39,7 +39,7 @@ from ..mesh.topology import connected_components
 from ..mesh.validate import as_mesh
 from ..numerics import cache as basis_cache
 from ..numerics.eigen import one_blas_thread, smallest_eigenpairs
-from .laplace import laplacian
+from .laplace import laplacian, uniform_laplacian, vertex_areas
 
 __all__ = [
     "eigenbasis",
@@ -53,14 +53,15 @@ __all__ = [
 _METHODS = {"auto": "auto", "dense": "dense", "sparse": "sparse", "arpack": "sparse"}
 
 
-def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=None):
+def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", tol=1e-10):
     """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
 
     ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
     Solved in the symmetric form ``Q y = lam y`` with ``Q = -M^-1/2 C M^-1/2``
     and ``e = M^-1/2 y`` (Vallet and Levy 2008): dense LAPACK for small meshes,
-    ARPACK shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) on one sparse
-    Cholesky factorisation otherwise (:mod:`geomlib.numerics.eigen`).
+    block Lanczos on the inverse of ``Q + shift I``, applied by one sparse
+    Cholesky factorisation, otherwise (:mod:`geomlib.numerics.eigen`). Every
+    call solves; :func:`spectral_basis` keeps the result in a cache.
 
     Parameters
     ----------
@@ -69,17 +70,13 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cach
     k : int, 1 <= k <= n
         Number of eigenpairs.
     weights, area : as in :func:`geomlib.laplacian`.
-    cache : bool
-        Read and write the memory and disk cache (:mod:`geomlib.numerics.cache`); with
-        ``cache=False`` the basis is always solved for and not stored.
-    cache_dir : str or Path, optional
-        Cache folder for this call (default: :func:`spectral_cache_dir`).
     method : "auto", "dense", "sparse" or "arpack"
         "auto" is "dense" (LAPACK) up to ``geomlib.numerics.eigen.DENSE_MAX`` vertices or
         when k is more than a third of n, "sparse" otherwise; "arpack" is
-        another name for "sparse".
-    tol : float or None
-        ARPACK's relative accuracy of the eigenvalues (default: machine precision).
+        another name for "sparse" (kept for old calls).
+    tol : float
+        Relative residual of the sparse solve, ``||Q y - lam y|| <= tol ||Q||``
+        (:func:`geomlib.numerics.eigen.smallest_eigenpairs`).
 
     Returns
     -------
@@ -112,9 +109,6 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cach
     gives the natural (Neumann) boundary condition, so the constant is still
     the first eigenvector.
     """
-    if cache:  # a basis stored by an earlier call, or this function's result, stored
-        basis = spectral_basis(V, F, k, weights, area, cache_dir=cache_dir, method=method, tol=tol)
-        return basis.lam.copy(), basis.E.copy(order="F")
     V, F = as_mesh(V, F)
     k, method = _check_k(k, len(V)), _check_method(method)
     M, C = laplacian(V, F, weights=weights, area=area)
@@ -122,7 +116,7 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, cache=True, cach
     D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
     Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q y = lam y (notebook 04's symbol)
     shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
-    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol or 0.0)
+    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol)
     E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
     return _tidy(lam, E, m, F)
 
@@ -201,10 +195,11 @@ class SpectralBasis:
     source : "solved", "memory" or "disk"
     """
 
-    def __init__(self, lam, E, m, components=1, seconds=0.0, source="solved"):
-        self.lam, self.E, self.m = lam, E, m
-        self.components, self.seconds, self.source = components, seconds, source
-        self._coefficients = {}
+    def __init__(self, lam, E, m, seconds=0.0, source="solved"):
+        self.lam, self.E, self.m = lam, np.asfortranarray(E), m
+        self.components, self.seconds, self.source = int((lam == 0).sum()), seconds, source
+        self._whole = self  # the basis this one is the first k columns of: it keeps the coefficients
+        self._last = (None, None)  # (key of X, E^T M X): a slider over k only multiplies
 
     @property
     def k(self):
@@ -216,6 +211,15 @@ class SpectralBasis:
             f"lam=[{self.lam[0]:.3g} .. {self.lam[-1]:.3g}], source={self.source!r})"
         )
 
+    def first(self, k, source=None):
+        """The basis of the first k eigenpairs (views, no copy)."""
+        k = self._k(k)
+        if k == self.k and source is None:
+            return self
+        part = SpectralBasis(self.lam[:k], self.E[:, :k], self.m, self.seconds, source or self.source)
+        part._whole = self._whole
+        return part
+
     def _k(self, k):
         if k is None:
             return self.k
@@ -226,19 +230,15 @@ class SpectralBasis:
     def coefficients(self, X):
         """Spectral coefficients ``E^T M X`` (k, ...) of per-vertex values X (n,) or (n, d).
 
-        Remembered for the last few X (by content), so a slider over k only multiplies.
+        Those of the last X are remembered (by content), so a slider over k only multiplies.
         """
         X = np.asarray(X, dtype=np.float64)
         if X.shape[0] != self.E.shape[0]:
             raise MeshError(f"X has {X.shape[0]} rows but the basis has {self.E.shape[0]} vertices")
-        h = (hashlib.blake2b(np.ascontiguousarray(X).view(np.uint8), digest_size=16).hexdigest(), X.shape)
-        c = self._coefficients.get(h)
-        if c is None:
-            c = self.E.T @ (self.m.reshape((-1,) + (1,) * (X.ndim - 1)) * X)
-            if len(self._coefficients) >= 4:
-                self._coefficients.pop(next(iter(self._coefficients)))
-            self._coefficients[h] = c
-        return c
+        whole, name = self._whole, basis_cache.key(X)
+        if whole._last[0] != name:
+            whole._last = (name, whole.E.T @ (self.m.reshape((-1,) + (1,) * (X.ndim - 1)) * X))
+        return whole._last[1][: self.k]
 
     def reconstruct(self, X, k=None):
         """``E_k E_k^T M X``: the M-orthogonal projection of X onto the first k eigenvectors."""
@@ -260,50 +260,38 @@ class SpectralBasis:
 
 
 def spectral_basis(
-    V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=None
+    V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto", tol=1e-10
 ):
-    """The first k eigenpairs as a :class:`SpectralBasis` (cached; see :func:`eigenbasis`).
+    """:func:`eigenbasis` behind a cache, as a :class:`SpectralBasis`.
 
-    ``basis.reconstruct(X, j)`` then projects per-vertex values X onto the
-    first j <= k eigenvectors without solving again (what a slider over k
-    needs); ``basis.residual_norms(X)`` gives the error for every j at once.
-    A stored basis with more than k eigenpairs serves the request.
+    The basis of a mesh and its options is kept in memory (the last few) and
+    on disk (:mod:`geomlib.numerics.cache`, under :func:`spectral_cache_dir`
+    or ``cache_dir``), so asking again, with any k up to the stored one, or
+    after a kernel restart, does not solve. ``cache=False`` neither reads nor
+    writes it. ``basis.reconstruct(X, j)`` then projects per-vertex values X
+    onto the first j <= k eigenvectors (what a slider over k needs);
+    ``basis.residual_norms(X)`` gives the error for every j at once.
     """
     V, F = as_mesh(V, F)
-    basis = _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol)
-    if basis.k == k:
-        return basis
-    return SpectralBasis(basis.lam[:k], basis.E[:, :k], basis.m, int((basis.lam[:k] == 0).sum()), 0.0, basis.source)
-
-
-def _stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol):
-    """The basis in memory, on disk or solved, with at least k eigenpairs (V, F validated)."""
-    k, method = _check_k(k, len(V)), _check_method(method)
-    name = basis_cache.key(V, F, weights, area) if cache else None
-    basis = basis_cache.recall(name) if cache else None
-    if basis is None or basis.k < k:
-        basis = _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name)
-    return basis
-
-
-def _stored_or_solved(V, F, k, weights, area, cache, cache_dir, method, tol, name):
-    folder = spectral_cache_dir(cache_dir)
+    k, _ = _check_k(k, len(V)), _check_method(method)
+    name, folder = basis_cache.key(V, F, "eigenbasis", weights, area), spectral_cache_dir(cache_dir)
+    kept = basis_cache.recall(name) if cache else None
+    if kept is not None and kept.k >= k:
+        return kept.first(k, "memory")
     stored = basis_cache.load(folder, name, k) if cache else None
-    t0 = time.perf_counter()
-    if stored is None:
-        lam, E = eigenbasis(V, F, k, weights, area, cache=False, method=method, tol=tol)
-        source = "solved"
+    if stored is not None:
+        basis = SpectralBasis(*stored, source="disk")
     else:
-        (lam, E), source = stored, "disk"
-    M, _ = laplacian(V, F, weights=weights, area=area)
-    m = positive_vertex_areas(M, F, "spectral_basis")
-    seconds = time.perf_counter() - t0 if source == "solved" else 0.0
-    basis = SpectralBasis(lam, E, m, int((lam == 0).sum()), seconds, source)
+        t0 = time.perf_counter()
+        lam, E = eigenbasis(V, F, k, weights, area, method=method, tol=tol)
+        seconds = time.perf_counter() - t0
+        m = uniform_laplacian(V, F)[0].diagonal() if weights == "uniform" else vertex_areas(V, F, area)
+        basis = SpectralBasis(lam, E, m, seconds)
+        if cache:
+            basis_cache.store(folder, name, lam, basis.E, m)
     if cache:
-        if source == "solved":
-            basis_cache.store(folder, name, lam, E)
         basis_cache.remember(name, basis)
-    return basis
+    return basis.first(k)
 
 
 def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cache=True, cache_dir=None, method="auto"):
@@ -311,20 +299,16 @@ def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cac
 
     The projection is orthogonal in the M inner product (``<f, g>_M = f^T M g``,
     the discrete ``int f g dA``), the one in which the eigenvectors are
-    orthonormal; ``k = n`` gives back V to rounding. With ``cache=True`` a
+    orthonormal; ``k = n`` gives back V to rounding. The basis comes from
+    :func:`spectral_basis` (``cache`` and ``cache_dir`` as there), so a
     repeated call with another k only multiplies.
 
     Returns
     -------
     V_k : (n, 3) float64, in the units of V.
     """
-    if cache:  # the basis of an earlier call: another k only multiplies
-        V, F = as_mesh(V, F)
-        return _stored_basis(V, F, k, weights, area, True, cache_dir, method, None).reconstruct(V, int(k))
     V, F = as_mesh(V, F)
-    M, _ = laplacian(V, F, weights=weights, area=area)
-    lam, E = eigenbasis(V, F, k, weights, area, cache=False, method=method)
-    return E @ (E.T @ (M @ V))
+    return spectral_basis(V, F, k, weights, area, cache=cache, cache_dir=cache_dir, method=method).reconstruct(V)
 
 
 def spectral_cache_dir(cache_dir=None):

@@ -23,6 +23,8 @@ from .errors import MeshError, format_indices
 from .validate import as_faces, as_mesh
 
 __all__ = [
+    "unpaired_vertices",
+    "edges_at_unpaired_vertices",
     "edges",
     "boundary_edges",
     "boundary_vertices",
@@ -566,14 +568,59 @@ def edge_face_counts(F, n=None):
     return np.stack([rows, counts.indices.astype(np.int64)], axis=1), counts.data.astype(np.int64)
 
 
+def unpaired_vertices(F, n=None, block=1 << 17):
+    """Boolean (n,): vertices whose half-edges do not pair up, the only candidates for a boundary.
+
+    Around a vertex i of a closed, consistently oriented fan, each neighbour j
+    is the next corner of one triangle (half-edge ``i -> j``) and the previous
+    corner of another (``j -> i``), so ``sum (next - prev)`` and ``sum (next^2
+    - prev^2)`` over the corners at i are both 0. An edge of one triangle, of
+    three, or of two with opposite orientations leaves a non-zero difference
+    ``d_j`` at its ends, and two probes that vanish together need at least
+    four such neighbours whose indices balance in both sums (three boundary
+    fans at one vertex, at the least). The sums are exact integers in float64
+    up to 2^22 vertices; above that every vertex is a candidate. Faces are
+    summed block by block: memory of one block, not of every corner.
+    """
+    F = as_faces(F, n)
+    n = _nverts(F, n)
+    if n > 1 << 22:
+        return np.ones(n, dtype=bool)
+    first, second = np.zeros(n), np.zeros(n)
+    for start in range(0, len(F), block):
+        Ft = F[start : start + block].T  # (3, b): corner rows
+        corner = Ft.ravel()
+        nxt = Ft[[1, 2, 0]].ravel().astype(np.float64)
+        prv = Ft[[2, 0, 1]].ravel().astype(np.float64)
+        first += np.bincount(corner, nxt - prv, minlength=n)
+        second += np.bincount(corner, (nxt - prv) * (nxt + prv), minlength=n)
+    return (first != 0) | (second != 0)
+
+
 def boundary_edge_counts(F, n=None):
     """Number of boundary edges (edges of exactly one face) at each vertex, (n,) int64.
 
     0 at interior vertices, 2 at a simple boundary vertex, 2k where k open
-    fans meet (a non-manifold "bow-tie").
+    fans meet (a non-manifold "bow-tie"). Edges are counted only around the
+    vertices whose half-edges do not pair up (:func:`unpaired_vertices`): on a
+    closed mesh nothing is sorted.
     """
-    E, count = edge_face_counts(F, n)
+    E, count = edges_at_unpaired_vertices(F, n)
     return np.bincount(E[count == 1].ravel(), minlength=_nverts(np.asarray(F), n)).astype(np.int64)
+
+
+def edges_at_unpaired_vertices(F, n=None):
+    """:func:`edge_face_counts` restricted to the edges at :func:`unpaired_vertices`: every
+    boundary edge, and every edge of three or more faces that unbalances the orientation."""
+    F = as_faces(F, n)
+    n = _nverts(F, n)
+    unpaired = unpaired_vertices(F, n)
+    at_unpaired = unpaired[F].any(axis=1)
+    if not at_unpaired.any():  # closed and consistently oriented: no boundary, nothing to sort
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    E, count = edge_face_counts(F[at_unpaired], n)
+    keep = unpaired[E].any(axis=1)  # every face of these edges was counted; an edge between two others was not
+    return E[keep], count[keep]
 
 
 def unreferenced_vertices(F, n):

@@ -2,7 +2,9 @@
 
 A basis is stored under a key that hashes the bytes of ``V`` and ``F``, the
 operator options and the geomlib version (:func:`key`); a stored basis with
-``k' >= k`` eigenpairs serves a request for ``k``. Files are ``<key>-k<k'>.npz``
+``k' >= k`` eigenpairs serves a request for ``k``. A file holds the
+eigenvalues ``lam`` (k,), the eigenvectors ``E`` (n, k) and the vertex
+masses ``m`` (n,), so a basis read back needs no operator. Files are ``<key>-k<k'>.npz``
 in the folder of :func:`folder`, written to a temporary name and renamed, so a
 reader never sees half a file.
 
@@ -36,7 +38,7 @@ CACHE_DIR = None
 MEMORY_SIZE = 3
 
 #: Bumped whenever the stored format or the solver's conventions change.
-FORMAT = 2
+FORMAT = 3
 
 _MEMORY = OrderedDict()
 
@@ -62,12 +64,16 @@ def folder(cache_dir=None):
     return Path(root).expanduser() / "spectral"
 
 
-def key(V, F, *options):
-    """Hex digest of the mesh bytes, the options, the geomlib version and the cache format."""
-    h = hashlib.blake2b(digest_size=16)
-    h.update(repr((V.shape, F.shape, options, version("geomlib"), FORMAT)).encode())
-    h.update(np.ascontiguousarray(V, dtype=np.float64).view(np.uint8))
-    h.update(np.ascontiguousarray(F, dtype=np.int64).view(np.uint8))
+def key(*parts):
+    """Hex digest of ``parts`` (arrays by their bytes, shape and dtype, anything else by its repr),
+    the geomlib version and the cache format: the one key of every cache in geomlib."""
+    h = hashlib.blake2b(repr((version("geomlib"), FORMAT)).encode(), digest_size=16)
+    for part in parts:
+        if isinstance(part, np.ndarray):
+            h.update(repr((part.shape, part.dtype.str)).encode())
+            h.update(np.ascontiguousarray(part).view(np.uint8))
+        else:
+            h.update(repr(part).encode())
     return h.hexdigest()
 
 
@@ -120,7 +126,7 @@ def _warn(message):
 
 
 def load(where, name, k):
-    """``(lam, E)`` of the stored basis of ``name`` with the fewest eigenpairs >= k, or None.
+    """``(lam, E, m)`` of the stored basis of ``name`` with the fewest eigenpairs >= k, or None.
 
     A file that cannot be read, or holds arrays of the wrong shape, gives a
     MeshWarning and None (the caller solves again and overwrites it).
@@ -137,9 +143,11 @@ def load(where, name, k):
     kk, path = candidates[0]
     try:
         with np.load(path) as data:
-            lam, E = data["lam"], data["E"]
-        if E.ndim != 2 or E.shape[1] != kk or lam.shape != (kk,):
-            raise ValueError(f"arrays of shape {lam.shape} and {E.shape}, expected ({kk},) and (n, {kk})")
+            lam, E, m = data["lam"], data["E"], data["m"]
+        if E.ndim != 2 or E.shape[1] != kk or lam.shape != (kk,) or m.shape != E.shape[:1]:
+            raise ValueError(
+                f"arrays of shape {lam.shape}, {E.shape} and {m.shape}, expected ({kk},), (n, {kk}) and (n,)"
+            )
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
         _warn(f"the cached eigenbasis {path} is damaged ({type(exc).__name__}: {exc}); solving again and replacing it")
         try:
@@ -147,11 +155,11 @@ def load(where, name, k):
         except OSError:
             pass
         return None
-    return lam, np.asfortranarray(E)
+    return lam, np.asfortranarray(E), m
 
 
-def store(where, name, lam, E):
-    """Write a basis; smaller stored bases of the same key are deleted. Never raises:
+def store(where, name, lam, E, m):
+    """Write a basis (``lam``, ``E``, ``m``); smaller stored bases of the same key are deleted. Never raises:
     a folder that cannot be written gives a MeshWarning and the basis is just not stored."""
     if where.exists() and not where.is_dir():
         _warn(
@@ -163,7 +171,7 @@ def store(where, name, lam, E):
     tmp = where / f".{name}-{os.getpid()}-{time.monotonic_ns()}.tmp.npz"
     try:
         where.mkdir(parents=True, exist_ok=True)
-        np.savez(tmp, lam=lam, E=E)
+        np.savez(tmp, lam=lam, E=E, m=m)
         os.replace(tmp, path)  # atomic: a reader never sees half a file
     except OSError as exc:
         _warn(
