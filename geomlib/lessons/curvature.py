@@ -37,7 +37,7 @@ import warnings
 import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
-from ..mesh.geometry import vertex_normals
+from ..mesh.geometry import face_blocks, vertex_normals
 from ..mesh.topology import boundary_edge_counts, edges_at_unpaired_vertices
 from ..mesh.validate import as_mesh, check_choice
 from .laplace import check_options, face_geometry, laplacian, vertex_areas
@@ -55,9 +55,6 @@ __all__ = [
 ]
 
 BOUNDARY_RULES = ("nan", "zero", "turning", "deficit")
-
-#: Faces per block in :func:`angle_sums` (a few MB of corner angles at a time).
-FACE_BLOCK = 1 << 17
 MEAN_BOUNDARY_RULES = ("formula", "nan", "zero")
 
 
@@ -146,8 +143,7 @@ def angle_sums(V, F):
     """
     V, F = as_mesh(V, F)
     total = np.zeros(len(V))
-    for start in range(0, len(F), FACE_BLOCK):
-        block = F[start : start + FACE_BLOCK]
+    for block in face_blocks(F):
         total += np.bincount(block.T.ravel(), corner_angles(V, block).T.ravel(), minlength=len(V))
     return total
 
