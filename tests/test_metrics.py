@@ -278,6 +278,19 @@ def test_hausdorff_samples_are_seeded():
     assert C.hausdorff(W) == C.hausdorff(W)
 
 
+def test_hausdorff_shortcuts_measure_the_same_points():
+    # with one connectivity the bounds come from corresponding points, and MeshComparison keeps the
+    # clean side: both only save work, so the estimate is the general one (meshes told apart by F_clean)
+    V, F = icosphere(3)
+    for sigma in (0.002, 0.02):
+        W = add_noise(V, F, sigma, seed=5)
+        general = hausdorff_distance(W, V, F, F.copy(), seed=9)
+        assert hausdorff_distance(W, V, F, seed=9) == pytest.approx(general, rel=1e-12)
+        C = MeshComparison(V, F, seed=9)
+        assert C.hausdorff(W) == pytest.approx(general, rel=1e-12)
+        assert C.hausdorff(W, seed=3) == pytest.approx(hausdorff_distance(W, V, F, F.copy(), seed=3), rel=1e-12)
+
+
 def test_hausdorff_is_at_least_the_vertex_to_vertex_lower_bound_and_at_most_max_displacement():
     V, F = icosphere(3)
     W = add_noise(V, F, 0.005, seed=8)
@@ -353,6 +366,8 @@ def test_every_method_of_the_comparison_gives_its_function():
     assert cmp.sharp_edge_error(W) == sharp_edge_error(W, V, F)
     values = cmp.evaluate(W, hausdorff=False)
     assert (values["normal_mean"], values["normal_p95"]) == normal_angle_error(W, V, F)
+    assert values["rms"] == pytest.approx(vertex_rms(W, V), rel=1e-14)
+    assert (values["area_change"], values["volume_change"]) == (area_change(W, V, F), volume_change(W, V, F))
     assert values["sharp_edge_error"] > 0 and values["area_change"] > 0
 
 

@@ -560,6 +560,8 @@ def test_the_operator_is_built_once_per_mesh_and_options():
     assert ExplicitSmoother(V, F).L is L and ImplicitSmoother(V, F).L is L
     assert laplace_operator(V, F, "uniform") is not L
     assert laplace_operator(V + 1e-9, F) is not L  # the key is the mesh's bytes
+    U = laplace_operator(V, F, "uniform")  # combinatorial: one for every position of the vertices
+    assert laplace_operator(V + 0.1, F, "uniform") is U and laplace_operator(V[:-1], F[:5], "uniform") is not U
 
 
 def test_not_positive_definite_is_a_clear_error():

@@ -233,19 +233,23 @@ class _SurfaceIndex:
             d[unsure] = self._distance_ball(P[unsure], d[unsure])
         return d
 
-    def max_distance(self, P):
-        """``max_i d(P[i], surface)``, exact, measuring few points exactly.
+    def max_distance(self, P, upper=None, floor=0.0):
+        """``max(floor, max_i d(P[i], surface))``, exact, measuring few points exactly.
 
-        The distance to the triangle with the nearest centroid is an upper
-        bound ``u_i`` of each point's distance. Points are measured exactly
-        (:meth:`distance`) in order of decreasing ``u_i`` until the next bound
-        is no larger than the largest exact distance found: no point left can
-        exceed it."""
+        Every point needs an upper bound ``u_i`` of its distance: ``upper``
+        when given (for example the distance to its corresponding point on
+        this surface), else the distance to the triangle with the nearest
+        centroid. Points are measured exactly (:meth:`distance`) in order of
+        decreasing ``u_i`` until the next bound is no larger than the largest
+        exact distance found (or ``floor``, a value known to be reached anyway):
+        no point left can exceed it."""
         P = np.asarray(P, dtype=np.float64)
-        _, nearest = self.tree.query(P, k=1, workers=-1)  # every point: both cores
-        u = point_triangle_distance(P, self.A[nearest], self.B[nearest], self.C[nearest])
+        if upper is None:
+            _, nearest = self.tree.query(P, k=1, workers=-1)  # every point: both cores
+            upper = point_triangle_distance(P, self.A[nearest], self.B[nearest], self.C[nearest])
+        u = np.asarray(upper, dtype=np.float64)
         order = np.argsort(-u, kind="stable")
-        best = 0.0
+        best = float(floor)
         batch = max(64, len(P) // 64)
         for start in range(0, len(P), batch):
             chunk = order[start : start + batch]
@@ -297,17 +301,51 @@ def sample_surface(V, F, count, seed):
 
 
 def _sample(V, F, count, rng):
-    if count <= 0:
-        return np.empty((0, 3))
-    area = np.linalg.norm(face_cross(V, F), axis=1)
+    face, weights = _sample_barycentric(V, F, count, rng)
+    return np.einsum("kc,kcd->kd", weights, V[F[face]])
+
+
+def _sample_barycentric(V, F, count, rng):
+    """Faces (k,) and barycentric weights (k, 3) of ``count`` points uniform by area on (V, F)."""
+    area = np.linalg.norm(face_cross(V, F), axis=1) if count > 0 else np.zeros(0)
     total = area.sum()
-    if total <= 0:
-        return np.empty((0, 3))
+    if count <= 0 or total <= 0:
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 3))
     face = rng.choice(len(F), size=count, p=area / total)
     r1 = np.sqrt(rng.random(count))
     r2 = rng.random(count)
-    a, b, c = (1 - r1), r1 * (1 - r2), r1 * r2
-    return a[:, None] * V[F[face, 0]] + b[:, None] * V[F[face, 1]] + c[:, None] * V[F[face, 2]]
+    return face, np.stack([1 - r1, r1 * (1 - r2), r1 * r2], axis=1)
+
+
+class _SurfacePoints:
+    """The points of the Hausdorff estimate on one surface (V, F): its vertices and random samples
+    uniform by area, kept as vertex indices and (face, barycentric weights), so that the same points
+    can be placed on any mesh of the same connectivity (:meth:`on`)."""
+
+    def __init__(self, V, F, samples_per_face, rng):
+        self.F, self.vertices = F, np.unique(F)
+        self.faces, self.weights = _sample_barycentric(V, F, int(round(samples_per_face * len(F))), rng)
+        self.points = self.on(V)
+
+    def on(self, X):
+        """The same points on the mesh (X, F): vertex i at X[i], a sample at its weights of its face's corners."""
+        return np.vstack([X[self.vertices], np.einsum("kc,kcd->kd", self.weights, X[self.F[self.faces]])])
+
+
+def _sample_streams(seed):
+    """Two independent random streams, for the samples of the two surfaces of a Hausdorff estimate
+    (independent, so that the clean side can be drawn once and kept, :class:`MeshComparison`)."""
+    return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)]
+
+
+def _one_sided(points, index, X=None, floor=0.0):
+    """``max(floor, max d(p, surface of index))`` over ``points`` (:class:`_SurfacePoints`), exact.
+
+    ``X``: the positions of the index's mesh when it shares the points' connectivity;
+    then each point's distance to its corresponding point there bounds its distance from above
+    (that point lies on the surface), so no nearest-triangle search is needed for the bounds."""
+    upper = None if X is None else np.linalg.norm(points.points - points.on(X), axis=1)
+    return index.max_distance(points.points, upper, floor)
 
 
 # ----------------------------------------------------------------------------
@@ -372,6 +410,7 @@ class MeshComparison:
         self._N_clean = face_cross(self.V_clean, self.F)
         self._area_clean = surface_area(self.V_clean, self.F)
         self._volume_clean = enclosed_volume(self.V_clean, self.F) if self.closed else None
+        self._clean_sides = {}  # seed -> the clean surface's Hausdorff points and triangle index
 
     def _check(self, V):
         V = as_vertices(V)
@@ -394,15 +433,18 @@ class MeshComparison:
         return _bend_error(self._check(V), self.F, *self._sharp_edges, self.bend_clean[self.sharp])
 
     def hausdorff(self, V, relative=True, seed=None):
-        """:func:`hausdorff_distance` to the clean surface, with this comparison's density and seed."""
-        return hausdorff_distance(
-            self._check(V),
-            self.V_clean,
-            self.F,
-            relative=relative,
-            samples_per_face=self.samples_per_face,
-            seed=self.seed if seed is None else seed,
+        """:func:`hausdorff_distance` to the clean surface, with this comparison's density and seed.
+
+        The clean surface's points and triangle index are prepared once per seed and kept."""
+        seed = self.seed if seed is None else seed
+        moved, clean = _sample_streams(seed)
+        if seed not in self._clean_sides:
+            points = _SurfacePoints(self.V_clean, self.F, self.samples_per_face, clean)
+            self._clean_sides[seed] = points, _SurfaceIndex(self.V_clean, self.F)
+        h = _hausdorff(
+            self._check(V), self.F, self.samples_per_face, moved, self.V_clean, self._clean_sides[seed], True
         )
+        return h / self.diagonal if relative else h
 
     def area_change(self, V):
         """:func:`area_change`: ``(A - A_clean) / A_clean``."""
@@ -425,11 +467,14 @@ class MeshComparison:
         ``"sharp_edge_error"`` (NaN when the clean mesh has no sharp edge).
         """
         V = self._check(V)
-        out = {"rms": self.vertex_rms(V)}
+        out = {"rms": vertex_rms(V, self.V_clean, relative=False) / self.diagonal}
         if hausdorff:
             out["hausdorff"] = self.hausdorff(V)
-        out["normal_mean"], out["normal_p95"] = _mean_and_p95(self.face_normal_angles(V))
-        out["area_change"] = self.area_change(V)
+        # N = 2 A_f n_f of every face, once for the normals and the area (face_areas: |N| / 2), since a
+        # sweep evaluates thousands of meshes
+        N = face_cross(V, self.F)
+        out["normal_mean"], out["normal_p95"] = _mean_and_p95(_normal_angles(N, self._N_clean))
+        out["area_change"] = _area_change(float((0.5 * np.linalg.norm(N, axis=1)).sum()), self._area_clean)
         out["volume_change"] = self.volume_change(V) if self.closed else float("nan")
         out["sharp_edge_error"] = self.sharp_edge_error(V)
         return out
@@ -505,16 +550,19 @@ def hausdorff_distance(V, V_clean, F, F_clean=None, relative=True, samples_per_f
     V_clean = as_vertices(V_clean, where="V_clean")
     F = as_faces(F, len(V))
     F_clean = F if F_clean is None else as_faces(F_clean, len(V_clean), where="F_clean")
-    rng = np.random.default_rng(seed)
-
-    def points(X, G):
-        count = int(round(samples_per_face * len(G)))
-        return np.vstack([X[np.unique(G)], _sample(X, G, count, rng)])
-
-    there = _SurfaceIndex(V_clean, F_clean).max_distance(points(V, F))
-    back = _SurfaceIndex(V, F).max_distance(points(V_clean, F_clean))
-    h = float(max(there, back))
+    moved, clean = _sample_streams(seed)
+    clean_side = _SurfacePoints(V_clean, F_clean, samples_per_face, clean), _SurfaceIndex(V_clean, F_clean)
+    h = _hausdorff(V, F, samples_per_face, moved, V_clean, clean_side, shared=F_clean is F)
     return h / bounding_box_diagonal(V_clean) if relative else h
+
+
+def _hausdorff(V, F, samples_per_face, rng, V_clean, clean_side, shared):
+    """The larger of the two one-sided distances; ``clean_side``: the clean surface's points and index.
+    ``shared``: the two meshes have the same connectivity (vertex i and face f of one are those of the other)."""
+    P, (Q, clean_index) = _SurfacePoints(V, F, samples_per_face, rng), clean_side
+    there = _one_sided(P, clean_index, V_clean if shared else None)
+    # only a point further than `there` can change the maximum: the other side measures only those
+    return float(_one_sided(Q, _SurfaceIndex(V, F), V if shared else None, floor=there))
 
 
 def face_normal_angles(V, V_clean, F):

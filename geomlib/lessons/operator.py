@@ -4,8 +4,10 @@ Notebooks 05 and 06 step ``P' = P + tau M^-1 C P`` and solve ``(M - tau C) P' = 
 many times with one operator. :class:`LaplaceOperator` holds what every step,
 step limit and fixed point of one mesh needs; :func:`laplace_operator` builds it
 on first use and keeps the last ``CACHE_SIZE`` in memory under one key,
-:func:`geomlib.numerics.cache.key` of the mesh's bytes and the options. So a
-smoother, a step limit and a slider on the same mesh assemble it once.
+:func:`geomlib.numerics.cache.key` of the mesh's bytes and the options (for
+uniform weights of F and the vertex count only: that operator does not depend on
+the positions, so every noisy copy of a mesh shares it). So a smoother, a step
+limit and a slider on the same mesh assemble it once.
 
 Boundary condition (open meshes): ``"fixed"`` keeps the boundary vertices B where
 they are (a Dirichlet condition), ``"free"`` moves them with the same operator.
@@ -53,7 +55,9 @@ def laplace_operator(V, F, weights="cotan", area="barycentric", boundary_conditi
     check_options(weights, area)
     check_choice("boundary_condition", boundary_condition, BOUNDARY_CONDITIONS)
     V, F = as_mesh(V, F)
-    name = cache.key(V, F, weights, area if weights == "cotan" else None, boundary_condition)
+    # the uniform operator is combinatorial (valences and edges): one per F, whatever the positions
+    shape = V if weights == "cotan" else len(V)
+    name = cache.key(shape, F, weights, area if weights == "cotan" else None, boundary_condition)
     L = _OPERATORS.pop(name, None) or LaplaceOperator(V, F, weights, area, boundary_condition)
     _OPERATORS[name] = L  # most recently used last
     while len(_OPERATORS) > CACHE_SIZE:

@@ -15,6 +15,7 @@ file where the folder should be is detected, reported with a
 caller solves again (and, where it can, replaces the damaged file).
 """
 
+import functools
 import hashlib
 import os
 import sys
@@ -64,10 +65,15 @@ def folder(cache_dir=None):
     return Path(root).expanduser() / "spectral"
 
 
+@functools.cache
+def _version():
+    return version("geomlib")  # read once: the installed metadata is searched on every call (about 1 ms)
+
+
 def key(*parts):
     """Hex digest of ``parts`` (arrays by their bytes, shape and dtype, anything else by its repr),
     the geomlib version and the cache format: the one key of every cache in geomlib."""
-    h = hashlib.blake2b(repr((version("geomlib"), FORMAT)).encode(), digest_size=16)
+    h = hashlib.blake2b(repr((_version(), FORMAT)).encode(), digest_size=16)
     for part in parts:
         if isinstance(part, np.ndarray):
             h.update(repr((part.shape, part.dtype.str)).encode())

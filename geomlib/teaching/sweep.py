@@ -175,7 +175,8 @@ def smoothing_sweep(
     :func:`geomlib.explicit_smoothing` and :func:`geomlib.implicit_smoothing`
     (:class:`geomlib.lessons.smoothing.ExplicitSmoother`,
     :class:`geomlib.lessons.smoothing.ImplicitSmoother`); implicit runs factorise
-    ``M - step C`` once per step.
+    ``M - step C`` once per step and noisy mesh, and with uniform weights once per
+    step for all noise levels (that operator depends on F alone).
 
     Parameters
     ----------
@@ -216,6 +217,9 @@ def smoothing_sweep(
         from tqdm.auto import tqdm
 
         bar = tqdm(total=runs, desc="smoothing sweep")
+    # the uniform operator depends on F alone: one implicit smoother, and its factorisation of each
+    # M - step C, serves every noise level (it smooths each noisy mesh from P = Vn)
+    shared = {}
     start = time.perf_counter()
     try:
         for i, sigma in enumerate(out.sigmas):
@@ -223,7 +227,11 @@ def smoothing_sweep(
             for key, value in C.evaluate(Vn, hausdorff=False).items():
                 out.noisy[key][i] = value
             for j, (method, weights) in enumerate(schemes):
-                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
+                smoother = shared.get((method, weights))
+                if smoother is None:
+                    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
+                    if method == "implicit" and weights == "uniform":
+                        shared[method, weights] = smoother
                 for k, value in enumerate(step_values[method]):
                     step = scale_free_step(Vn, C.F, method, weights, value)
                     out.steps[i, j, k] = step
@@ -238,7 +246,7 @@ def smoothing_sweep(
                         if method == "explicit":
                             smoother.smooth(step, last, callback=record, on_failure="stop", progress=False)
                         else:
-                            smoother.smooth(step, last, callback=record, progress=False)
+                            smoother.smooth(step, last, callback=record, progress=False, P=Vn)
                     if bar is not None:
                         bar.update(1)
     finally:
