@@ -40,7 +40,6 @@ import numbers
 import warnings
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
 from ..mesh.geometry import bounding_box_diagonal, surface_area, volume_and_centroid
@@ -85,8 +84,8 @@ def explicit_step(P, M, C, tau):
     (:func:`geomlib.laplacian`), tau the step (length^2 for cotan weights).
     Stable for ``tau < 2 / lam_max`` (:func:`explicit_step_limit`).
     """
-    m = positive_vertex_areas(M, None, "explicit_step")
-    return P + tau * (sp.diags(1.0 / m) @ (C @ P))
+    m = positive_vertex_areas(M, None, "explicit_step")  # the diagonal of M, checked
+    return P + tau * ((C @ P).T / m).T  # M^-1 (C P): row i of C P divided by m_i
 
 
 def implicit_step(P, M, C, tau, solve=None):
