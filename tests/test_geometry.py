@@ -1,9 +1,9 @@
-"""Tests of geomlib.mesh.geometry's vertex normals against exact answers."""
+"""Tests of geomlib.mesh.geometry's vertex normals and volumes against exact answers."""
 
 import numpy as np
 import trimesh
 
-from geomlib.mesh.geometry import vertex_normals
+from geomlib.mesh.geometry import enclosed_volume, face_cross, face_volumes, vertex_normals, volume_and_centroid
 
 
 def test_vertex_normals_on_a_sphere_are_radial_and_unit():
@@ -28,3 +28,15 @@ def test_vertex_normals_weigh_faces_by_area():
     N = vertex_normals(V, F)
     np.testing.assert_allclose(N[0], np.array([0.5, 0.0, 2.0]) / np.hypot(0.5, 2.0), atol=1e-15)
     np.testing.assert_array_equal(N[5], 0.0)  # in no face: no normal, not NaN
+
+
+def test_face_volumes_sum_to_the_enclosed_volume_wherever_the_origin_is():
+    # a box 2 x 1 x 0.5 centred at (3, -1, 2): volume 1, centroid the centre, for any origin
+    m = trimesh.creation.box(extents=(2.0, 1.0, 0.5))
+    V, F = np.asarray(m.vertices) + [3.0, -1.0, 2.0], np.asarray(m.faces, dtype=np.int64)
+    assert face_volumes(V, F).sum() == enclosed_volume(V, F) == enclosed_volume(V, F, face_cross(V, F))
+    assert abs(enclosed_volume(V, F) - 1.0) < 1e-14
+    vol, centroid = volume_and_centroid(V, F)
+    assert vol == enclosed_volume(V, F)
+    np.testing.assert_allclose(centroid, [3.0, -1.0, 2.0], atol=1e-14)
+    assert abs(enclosed_volume(V, F[:, ::-1]) + 1.0) < 1e-14  # clockwise faces: the volume's sign flips

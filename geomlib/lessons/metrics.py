@@ -470,12 +470,13 @@ class MeshComparison:
         out = {"rms": vertex_rms(V, self.V_clean, relative=False) / self.diagonal}
         if hausdorff:
             out["hausdorff"] = self.hausdorff(V)
-        # N = 2 A_f n_f of every face, once for the normals and the area (face_areas: |N| / 2), since a
-        # sweep evaluates thousands of meshes
+        # N = 2 A_f n_f of every face, once for the normals, the area (face_areas: |N| / 2) and the
+        # volume, since a sweep evaluates thousands of meshes
         N = face_cross(V, self.F)
         out["normal_mean"], out["normal_p95"] = _mean_and_p95(_normal_angles(N, self._N_clean))
         out["area_change"] = _area_change(float((0.5 * np.linalg.norm(N, axis=1)).sum()), self._area_clean)
-        out["volume_change"] = self.volume_change(V) if self.closed else float("nan")
+        volume = enclosed_volume(V, self.F, N) if self.closed else None
+        out["volume_change"] = _volume_change(volume, self._volume_clean) if self.closed else float("nan")
         out["sharp_edge_error"] = self.sharp_edge_error(V)
         return out
 

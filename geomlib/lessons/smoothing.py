@@ -350,7 +350,7 @@ class ExplicitSmoother:
         try:
             for k in range(1, iterations + 1):
                 P_next = explicit_step(P, M, C, tau)
-                if not np.isfinite(P_next).all() or np.abs(P_next - self.V).max() > far:
+                if not np.abs(P_next - self.V).max() <= far:  # one pass: NaN fails the comparison, inf exceeds far
                     message = (
                         f"explicit smoothing diverged at iteration {k} (step "
                         f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals"
