@@ -30,7 +30,15 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..mesh.errors import MeshError
-from ..mesh.geometry import bounding_box_diagonal, cross, enclosed_volume, face_cross, mean_edge_length, surface_area
+from ..mesh.geometry import (
+    bounding_box_diagonal,
+    cross,
+    enclosed_volume,
+    face_cross,
+    face_volumes,
+    mean_edge_length,
+    surface_area,
+)
 from ..mesh.topology import Topology
 from ..mesh.validate import as_faces, as_vertices
 
@@ -475,7 +483,7 @@ class MeshComparison:
         N = face_cross(V, self.F)
         out["normal_mean"], out["normal_p95"] = _mean_and_p95(_normal_angles(N, self._N_clean))
         out["area_change"] = _area_change(float((0.5 * np.linalg.norm(N, axis=1)).sum()), self._area_clean)
-        volume = enclosed_volume(V, self.F, N) if self.closed else None
+        volume = float(face_volumes(V, self.F, N).sum()) if self.closed else None  # enclosed_volume, V and F checked
         out["volume_change"] = _volume_change(volume, self._volume_clean) if self.closed else float("nan")
         out["sharp_edge_error"] = self.sharp_edge_error(V)
         return out
