@@ -256,15 +256,15 @@ class _SurfaceIndex:
             _, nearest = self.tree.query(P, k=1, workers=-1)  # every point: both cores
             upper = point_triangle_distance(P, self.A[nearest], self.B[nearest], self.C[nearest])
         u = np.asarray(upper, dtype=np.float64)
-        order = np.argsort(-u, kind="stable")
         best = float(floor)
         batch = max(64, len(P) // 64)
-        for start in range(0, len(P), batch):
-            chunk = order[start : start + batch]
-            chunk = chunk[u[chunk] > best]
-            if len(chunk) == 0:
-                break
-            best = max(best, float(self.distance(P[chunk]).max()))
+        left = np.flatnonzero(u > best)  # the points that could still exceed best
+        while len(left):
+            # the batch with the largest bounds (a partition: most runs end after one or two batches)
+            top = np.argpartition(-u[left], batch)[:batch] if len(left) > batch else np.arange(len(left))
+            best = max(best, float(self.distance(P[left[top]]).max()))
+            left = np.delete(left, top)
+            left = left[u[left] > best]
         return best
 
     def _distance_ball(self, P, upper):
