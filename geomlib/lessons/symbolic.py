@@ -122,9 +122,10 @@ def _tidy(expr, full=False):
     writing sin^2 as 1 - cos^2 (sympy's ``TR5``) or cos^2 as 1 - sin^2
     (``TR6``) and factoring finds it too. Over the 24 expressions the
     ellipsoid of notebook 02 passes through here, that took 0.56 s against
-    1.58 s with ``simplify`` (one process, same machine), with the same forms
-    everywhere the notebook shows one; the tangent frame comes out shorter
-    (a b^2 sin v cos u cos v instead of a b^2 (sin(u + 2v) - sin(u - 2v)) / 4).
+    1.58 s with ``simplify`` (one process, 2 cores, load average 2.5), with
+    the same forms everywhere the notebook shows one; the tangent frame comes
+    out shorter (a b^2 sin v cos u cos v instead of
+    a b^2 (sin(u + 2v) - sin(u - 2v)) / 4).
     """
     expr = sp.sympify(expr)
     if expr.is_number:
