@@ -30,6 +30,15 @@ non-manifold vertex (several fans of triangles) the deficit is
 edges with three or more triangles count as interior and are reported when
 they unbalance the orientation around a vertex (always so for an odd number of
 triangles; ``geomlib.check_mesh`` lists them all).
+
+Speed (``benchmarks/bench_laplace.py``, 655k-vertex icosphere, libigl's
+``gaussian_curvature`` in the same run, load average 2.3-3.5 on 2 cores):
+``gaussian_curvature`` takes 0.88-0.92x libigl's time in CPU time (0.73-1.09x
+wall-clock, best of 12-15 runs; 1.8-2.1x before, on the same machine) and 1.7x
+its peak memory (1.65x before); the integrated deficit 0.55x and 1.5x. The angles and the vertex areas come from one
+pass over blocks of faces (V checked and transposed once, each block's edge
+lengths and areas shared, sums added in place), and the half-edge probes skip
+the edge table on a closed mesh.
 """
 
 import warnings
@@ -121,7 +130,7 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
 
 
 def corner_angles(V, F):
-    """Angles (m, 3) in radians at the corners of each face (:func:`face_angles` of :func:`geomlib.lessons.laplace.face_geometry`)."""
+    """Angles (m, 3) in radians at the corners of each face: :func:`face_angles` of ``face_geometry(V, F)``."""
     return face_angles(face_geometry(V, F))
 
 
