@@ -100,7 +100,7 @@ def corner_geometry(v0, v1, v2):
     N2 = cross(e[1], e[2])  # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
     dblA = np.sqrt(np.einsum("cf,cf->f", N2, N2))
     degenerate = is_zero_area(dblA, l2.max(axis=0))
-    cot = (l2.sum(axis=0) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))
+    cot = (0.5 * l2.sum(axis=0) - l2) / np.where(degenerate, 1.0, dblA)  # <e_j, -e_k> / 2A
     cot[:, degenerate] = 0.0
     # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
     return l2.T, dblA, cot.T, degenerate
