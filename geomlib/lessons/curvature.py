@@ -32,13 +32,14 @@ they unbalance the orientation around a vertex (always so for an odd number of
 triangles; ``geomlib.check_mesh`` lists them all).
 
 Speed (``benchmarks/bench_laplace.py``, 655k-vertex icosphere, libigl's
-``gaussian_curvature`` in the same run, load average 2.3-3.5 on 2 cores):
-``gaussian_curvature`` takes 0.88-0.92x libigl's time in CPU time (0.73-1.09x
-wall-clock, best of 12-15 runs; 1.8-2.1x before, on the same machine) and 1.7x
-its peak memory (1.65x before); the integrated deficit 0.55x and 1.5x. The angles and the vertex areas come from one
-pass over blocks of faces (V checked and transposed once, each block's edge
-lengths and areas shared, sums added in place), and the half-edge probes skip
-the edge table on a closed mesh.
+``gaussian_curvature`` in the same run, 2 cores shared, load average 1.8-3.9):
+``gaussian_curvature`` takes 0.77-0.96x libigl's wall-clock time (best of 15;
+one run of 12 at load 3.4 gave 1.09x), 0.88-0.96x in CPU time, against 1.7-2.1x
+before on the same machine; its peak memory is 1.7x libigl's (1.65x before). The
+integrated deficit takes 0.5-0.57x and 1.5x. The angles and the vertex areas come
+from one pass over blocks of faces (V checked and transposed once, each block's
+edge lengths and areas shared, sums added in place), and the half-edge probes
+skip the edge table on a closed mesh.
 """
 
 import warnings
