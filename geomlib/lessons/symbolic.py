@@ -109,11 +109,11 @@ def _exact(x):
     return sp.sympify(x)
 
 
-def _tidy(expr, full=False):
+def _tidy(expr):
     """Simplify a scalar expression, keeping the form with the fewest operations.
 
     Candidates: the expression, ``factor``, ``cancel`` + ``factor`` and, for
-    small expressions (or ``full=True``), either the two Pythagorean rewrites
+    small expressions, either the two Pythagorean rewrites
     (below) where sines or cosines of the variables occur, or ``simplify``.
     Full ``simplify`` on the large expressions of a general ellipsoid takes
     tens of seconds and seldom wins, so it is skipped there.
@@ -131,7 +131,7 @@ def _tidy(expr, full=False):
     if expr.is_number:
         return sp.simplify(expr)
     rewrites = [sp.factor, lambda x: sp.factor(sp.cancel(x))]
-    if full or sp.count_ops(expr) <= 60:
+    if sp.count_ops(expr) <= 60:
         if any(f.free_symbols for f in expr.atoms(sp.sin, sp.cos)):
             rewrites += [lambda x: sp.factor(TR5(x)), lambda x: sp.factor(TR6(x))]
         else:
