@@ -451,6 +451,23 @@ def test_sweep_records_what_a_direct_run_gives():
     )
     assert R.values["rms"].shape == (2, 4, 2, 3)
     assert not np.isnan(R.values["rms"]).any()
+    # the second noise level ran in the worker process (on Linux): the same numbers as in this one
+    serial = smoothing_sweep(
+        V,
+        F,
+        [0.002, 0.01],
+        seed=3,
+        explicit_fractions=(0.25, 0.5),
+        implicit_steps=(0.1, 1.0),
+        iterations=(1, 3, 5),
+        progress=False,
+        workers=1,
+    )
+    for key in R.values:
+        np.testing.assert_array_equal(R.values[key], serial.values[key], err_msg=key)
+        np.testing.assert_array_equal(R.noisy[key], serial.noisy[key], err_msg=key)
+    np.testing.assert_array_equal(R.steps, serial.steps)
+    assert serial.worker_seconds == 0.0
     C = MeshComparison(V, F)
     # one entry redone by hand: implicit cotan, step value 1.0, 3 iterations, sigma 0.01
     W = add_noise(V, F, 0.01, seed=3)

@@ -541,7 +541,14 @@ def test_the_sweep_advances_by_the_shown_steps(monkeypatch):
 
     def sweep():
         return smoothing_sweep(
-            V, F, [0.01], seed=1, explicit_fractions=[0.5], implicit_steps=[0.3], iterations=[1, 2], progress=False
+            V,
+            F,
+            [0.01, 0.02],
+            seed=1,
+            explicit_fractions=[0.5],
+            implicit_steps=[0.3],
+            iterations=[1, 2],
+            progress=False,
         )
 
     right = sweep().values["rms"]
