@@ -106,11 +106,14 @@ def render_still(
     fov=FOV,
     background=(1.0, 1.0, 1.0),
     centre=None,
+    cull_back=False,
 ):
     """Draw the mesh as the viewer's camera first sees it, into an RGB image.
 
     The camera looks at ``centre`` (default: the centre of V's bounding box)
-    from ``distance`` (default: framing V's bounding box).
+    from ``distance`` (default: framing V's bounding box). ``cull_back`` skips
+    the triangles that face away from the camera, as the live view does on a
+    closed, outward-oriented mesh (half the work; nothing visible changes).
 
     A z-buffer rasteriser in numpy: vertices are projected with the camera of
     the 3D view, shaded by the same head light (|n . e|, both sides lit), and
@@ -144,7 +147,7 @@ def render_still(
     vc = np.asarray(colors, dtype=np.float64)[:, :3] * shade[:, None] + 0.12 * (d**40)[:, None]
     inv = 1.0 / depth
 
-    pix, face, b0, b1 = fragments(sx[F], sy[F], inv[F], width, height)
+    pix, face, b0, b1 = fragments(sx[F], sy[F], inv[F], width, height, cull_back)
     image = np.empty((height * width, 3), dtype=np.float64)
     image[:] = background
     if pix.size:
@@ -156,14 +159,17 @@ def render_still(
     return (np.clip(image, 0.0, 1.0) * 255 + 0.5).astype(np.uint8).reshape(height, width, 3)
 
 
-def fragments(X, Y, inv, width, height, budget=2_000_000):
+def fragments(X, Y, inv, width, height, cull_back=False, budget=2_000_000):
     """The pixels the triangles cover, nearest first: ``(pix, face, b0, b1)`` of the visible fragments.
 
     ``X``, ``Y`` (m, 3) are the screen corners of the triangles and ``inv`` (m, 3)
     their 1/depth. A pixel is covered when its centre has barycentric
     coordinates b0, b1, b2 = 1 - b0 - b1 all >= 0; of the fragments of one
     pixel the largest interpolated 1/depth wins (a z-buffer). Returns the pixel
-    index (row * width + column), the face and b0, b1 of each winner.
+    index (row * width + column), the face and b0, b1 of each winner. With
+    ``cull_back`` the triangles facing away are left out: those whose corners
+    run clockwise as seen from the camera (positive ``area`` here, the screen's y
+    pointing down).
 
     Why row by row: a triangle's box can be many times its area (a long sliver;
     the spikes of an unstable run cover a picture 17 times over), and testing
@@ -179,7 +185,8 @@ def fragments(X, Y, inv, width, height, budget=2_000_000):
     y0 = np.maximum(np.floor(Y.min(axis=1) - 0.5), 0).astype(np.int64)
     x1 = np.minimum(np.floor(X.max(axis=1) - 0.5) + 1, width - 1).astype(np.int64)
     y1 = np.minimum(np.floor(Y.max(axis=1) - 0.5) + 1, height - 1).astype(np.int64)
-    faces = np.flatnonzero((x1 >= x0) & (y1 >= y0) & (np.abs(area) > 1e-12))
+    drawn = (area < -1e-12) if cull_back else (np.abs(area) > 1e-12)
+    faces = np.flatnonzero((x1 >= x0) & (y1 >= y0) & drawn)
     group = np.cumsum((x1[faces] - x0[faces] + 1) * (y1[faces] - y0[faces] + 1)) // budget
     nearest = np.full(height * width, -np.inf)
     kept = []
