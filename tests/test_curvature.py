@@ -206,6 +206,58 @@ def test_angle_sums_add_to_pi_per_triangle():
     assert angle_sums(m.V, m.F).sum() == pytest.approx(np.pi * len(m.F), rel=1e-14)
 
 
+@pytest.mark.parametrize("area", ["barycentric", "mixed"])
+def test_one_pass_over_blocks_equals_the_separate_formulas(monkeypatch, area):
+    """Angles and areas measured together, 7 faces per block, are the per-face formulas summed at the vertices."""
+    import geomlib.lessons.laplace as laplace
+    from geomlib.lessons.curvature import angle_and_area_sums, corner_angles
+    from geomlib.mesh.geometry import face_blocks
+
+    m = surfaces.torus(1.0, 0.3, n=20, jitter=0.3, seed=1)
+    V, F = m.V, m.F
+    theta = corner_angles(V, F)
+    expected = np.zeros(len(V))
+    np.add.at(expected, F, theta)
+    A = laplace.vertex_areas(V, F, area)
+    monkeypatch.setattr(laplace, "face_blocks", lambda F: face_blocks(F, 7))
+    theta_sum, A_blocks = angle_and_area_sums(V, F, area)
+    assert len(F) > 10 * 7 and len(F) % 7  # many blocks, and a last one that is shorter
+    np.testing.assert_allclose(theta_sum, expected, rtol=1e-14)
+    np.testing.assert_allclose(A_blocks, A, rtol=1e-13)
+    assert angle_and_area_sums(V, F)[1] is None
+    np.testing.assert_allclose(gaussian_curvature(V, F, area), (2 * np.pi - expected) / A, rtol=1e-10, atol=1e-12)
+
+
+def test_zero_area_face_in_a_later_block_is_named_by_its_index(monkeypatch):
+    import geomlib.lessons.laplace as laplace
+    from geomlib.mesh.geometry import face_blocks
+
+    m = surfaces.sphere(1.0, 1)
+    a, b, c = m.F[0]
+    V = np.vstack([m.V, 0.5 * (m.V[a] + m.V[b])])
+    w = len(V) - 1
+    F = np.vstack([m.F[1:], [[a, w, c], [w, b, c], [b, w, a]]])  # the sliver (b, w, a) is the last face
+    monkeypatch.setattr(laplace, "face_blocks", lambda F: face_blocks(F, 5))
+    with pytest.warns(MeshWarning, match=f"zero-area triangle.*faces {len(F) - 1}$"):
+        K = gaussian_curvature(V, F)
+    assert np.isfinite(K).all()
+
+
+def test_a_vertex_seen_only_at_zero_angles_is_not_unreferenced():
+    # vertex 1 is in the zero-area triangle (0, 1, 3) only, at a corner of angle 0: its angle sum is 0,
+    # but it is in a triangle, so the deficit is 2 pi there (not NaN); vertex 4 is in no triangle
+    from geomlib.lessons.curvature import angle_deficit
+
+    V = np.array([[0.0, 0, 0], [8, 0, 0], [0, 3, 0], [4, 0, 0], [9, 9, 9]])
+    F = np.array([[0, 3, 2], [0, 1, 3]])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        deficit = angle_deficit(V, F)
+    unreferenced = [str(x.message) for x in caught if "in no triangle;" in str(x.message)]
+    assert len(unreferenced) == 1 and unreferenced[0].endswith("vertices 4")
+    assert deficit[1] == 2 * np.pi and np.isnan(deficit[4]) and np.isfinite(deficit[:4]).all()
+
+
 # ---------------------------------------------------------------- bad input
 
 

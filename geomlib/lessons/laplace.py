@@ -90,16 +90,32 @@ def face_geometry(V, F):
         Zero-area faces (:func:`geomlib.mesh.validate.is_zero_area`).
     """
     V, F = as_mesh(V, F)
-    v0, v1, v2 = corner_positions(V, F)  # (3, m) coordinate rows of each corner
+    return corner_geometry(*corner_positions(V, F))
+
+
+def corner_geometry(v0, v1, v2):
+    """:func:`face_geometry` from the (3, m) coordinate rows of the corners (unchecked input)."""
     e = (v2 - v1, v0 - v2, v1 - v0)  # e_i = v_k - v_j, the edge opposite corner i
     l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])  # |e_i|^2, (3, m)
     N2 = cross(e[1], e[2])  # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
     dblA = np.sqrt(np.einsum("cf,cf->f", N2, N2))
     degenerate = is_zero_area(dblA, l2.max(axis=0))
-    cot = (l2.sum(axis=0) - 2.0 * l2) / (2.0 * np.where(degenerate, 1.0, dblA))
+    cot = (0.5 * l2.sum(axis=0) - l2) / np.where(degenerate, 1.0, dblA)  # <e_j, -e_k> / 2A
     cot[:, degenerate] = 0.0
     # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
     return l2.T, dblA, cot.T, degenerate
+
+
+def measured_blocks(V, F):
+    """``(block, face_geometry(V, block))`` for each of ``geomlib.mesh.geometry.face_blocks(F)``.
+
+    Unchecked input: the caller has validated V and F, once rather than once per block. A sum
+    over faces done this way holds one block's corner temporaries at a time: at 655k vertices
+    tens of MB instead of hundreds.
+    """
+    Vt = np.ascontiguousarray(V.T).T  # V, transposed once: corner_positions then copies nothing per block
+    for block in face_blocks(F):
+        yield block, corner_geometry(*corner_positions(Vt, block))
 
 
 def measured_faces(V, F):
@@ -115,11 +131,9 @@ def measured_faces(V, F):
 def measured_areas(V, F):
     """Twice the area (m,) and the zero-area flag (m,) of every face, as :func:`face_geometry` gives them.
 
-    Measured block by block of faces, so only one block's corner temporaries exist at a time
-    (the vertex areas of a 655k-vertex mesh in tens of MB instead of hundreds); warns as
-    :func:`measured_faces` does.
+    Measured block by block (:func:`measured_blocks`); warns as :func:`measured_faces` does.
     """
-    blocks = [face_geometry(V, block)[1::2] for block in face_blocks(F)]  # keep (dblA, degenerate) only
+    blocks = [faces[1::2] for _, faces in measured_blocks(V, F)]  # keep (dblA, degenerate) only
     dblA = np.concatenate([b[0] for b in blocks])
     degenerate = np.concatenate([b[1] for b in blocks])
     warn_zero_area(degenerate, stacklevel=4)
@@ -193,7 +207,7 @@ def barycentric_areas(V, F, faces=None):
     V, F = as_mesh(V, F)
     dblA, degenerate = (faces[1], faces[3]) if faces else measured_areas(V, F)
     third = np.where(degenerate, 0.0, dblA / 6.0)
-    return sum(np.bincount(F[:, c], third, minlength=len(V)) for c in range(3))  # to each of the 3 corners
+    return np.bincount(F.ravel(), np.repeat(third, 3), minlength=len(V))  # to each of the 3 corners
 
 
 def mixed_areas(V, F, faces=None):

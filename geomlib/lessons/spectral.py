@@ -116,7 +116,8 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
     D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
     Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q y = lam y (notebook 04's symbol)
     shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
-    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol)
+    Y0 = null_vectors(F, m)  # Q (sqrt(A_i) on one component, 0 elsewhere) = 0: known, kept out of the solve
+    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol, null=Y0)
     E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
     return _tidy(lam, E, m, F)
 
@@ -148,6 +149,18 @@ def _components(F, m):
     rank = np.empty(count, dtype=np.int64)
     rank[np.lexsort((np.arange(count), -size))] = np.arange(count)  # labels follow the first vertex
     return count, rank[labels]
+
+
+def null_vectors(F, m):
+    """Orthonormal (n, c) eigenvectors of ``Q = -M^-1/2 C M^-1/2`` for ``lam = 0``, one per connected component.
+
+    Column c is ``sqrt(m)`` on the vertices of component c (numbered by area,
+    largest first, as :func:`eigenbasis` orders them) and 0 elsewhere,
+    normalised: ``Q`` maps it to 0 because every row of C sums to 0.
+    """
+    count, labels = _components(F, m)
+    Y0 = (labels[:, None] == np.arange(count)[None, :]) * np.sqrt(m)[:, None]
+    return Y0 / np.linalg.norm(Y0, axis=0)
 
 
 def _tidy(lam, E, m, F):

@@ -568,7 +568,11 @@ def edge_face_counts(F, n=None):
     return np.stack([rows, counts.indices.astype(np.int64)], axis=1), counts.data.astype(np.int64)
 
 
-def unpaired_vertices(F, n=None, block=1 << 17):
+#: faces per block in :func:`unpaired_vertices` (a few MB of per-corner temporaries at a time)
+PROBE_BLOCK = 1 << 17
+
+
+def unpaired_vertices(F, n=None, block=PROBE_BLOCK):
     """Boolean (n,): vertices whose half-edges do not pair up, the only candidates for a boundary.
 
     Around a vertex i of a closed, consistently oriented fan, each neighbour j
@@ -583,7 +587,11 @@ def unpaired_vertices(F, n=None, block=1 << 17):
     summed block by block: memory of one block, not of every corner.
     """
     F = as_faces(F, n)
-    n = _nverts(F, n)
+    return _unpaired(F, _nverts(F, n), block)
+
+
+def _unpaired(F, n, block=PROBE_BLOCK):
+    """:func:`unpaired_vertices` of checked faces."""
     if n > 1 << 22:
         return np.ones(n, dtype=bool)
     first, second = np.zeros(n), np.zeros(n)
@@ -592,8 +600,9 @@ def unpaired_vertices(F, n=None, block=1 << 17):
         corner = Ft.ravel()
         nxt = Ft[[1, 2, 0]].ravel().astype(np.float64)
         prv = Ft[[2, 0, 1]].ravel().astype(np.float64)
-        first += np.bincount(corner, nxt - prv, minlength=n)
-        second += np.bincount(corner, (nxt - prv) * (nxt + prv), minlength=n)
+        d = nxt - prv
+        np.add.at(first, corner, d)  # in place: no (n,) array per block
+        np.add.at(second, corner, d * (nxt + prv))
     return (first != 0) | (second != 0)
 
 
@@ -614,10 +623,10 @@ def edges_at_unpaired_vertices(F, n=None):
     boundary edge, and every edge of three or more faces that unbalances the orientation."""
     F = as_faces(F, n)
     n = _nverts(F, n)
-    unpaired = unpaired_vertices(F, n)
-    at_unpaired = unpaired[F].any(axis=1)
-    if not at_unpaired.any():  # closed and consistently oriented: no boundary, nothing to sort
+    unpaired = _unpaired(F, n)
+    if not unpaired.any():  # closed and consistently oriented: no boundary, nothing to sort
         return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    at_unpaired = unpaired[F].any(axis=1)
     E, count = edge_face_counts(F[at_unpaired], n)
     keep = unpaired[E].any(axis=1)  # every face of these edges was counted; an edge between two others was not
     return E[keep], count[keep]

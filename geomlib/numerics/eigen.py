@@ -2,8 +2,9 @@
 
 * :func:`smallest_eigenpairs` -- the k smallest eigenpairs of S: dense LAPACK
   (``scipy.linalg.eigh``) for small matrices, else :func:`shift_invert_lanczos`,
-  block Lanczos on ``(S + shift I)^-1`` applied by one sparse Cholesky
-  factorisation (:mod:`geomlib.numerics.factor`) computed once.
+  block Lanczos on ``(S + shift I)^-1``, or on its square when S's null space
+  is given, applied by one sparse Cholesky factorisation
+  (:mod:`geomlib.numerics.factor`) computed once.
 
   Why a Lanczos iteration of its own and not ARPACK (``eigsh`` with the same
   factorisation as ``OPinv``): at k = 200 most of ARPACK's time is not in the
@@ -35,7 +36,23 @@
   matrix-vector product: no faster in our runs, 2.2 s against 1.9-3.4 s for
   blocks of 8 at load averages of 4-6, and one start vector finds only one
   vector of a repeated eigenvalue, as on an icosphere), blocks of 16 or 32
-  (20-60 % more vectors than blocks of 8). LOBPCG
+  (20-60 % more vectors than blocks of 8).
+
+  With the null space known (``null``: the constants of each component of a
+  mesh operator), the iteration runs on ``(S + shift I)^-2`` with those
+  vectors locked out of the basis. Squaring doubles the relative gaps of the
+  wanted end of the spectrum, so fewer vectors are needed (536 against 720
+  for k = 200 on a 25.6k-vertex torus), and each costs two solves instead of
+  one; the orthogonalisation, which grows with the square of the basis,
+  dominates below about 50k vertices. Measured in one run each, same
+  meshes, load average 1.7-2.5: k = 200 on the 25.6k-vertex torus 3.5-3.8 s
+  -> 2.9 s, on notebook 04's 20k-vertex creature 2.2-2.3 s -> 1.6-1.8 s, on
+  the 10k bumpy icosphere 1.1-1.4 s -> 0.9-1.1 s; at 40k vertices 4.7-4.9 s
+  -> 4.6 s; at 160k vertices, where a solve costs more, k = 50 7.2-7.4 s ->
+  7.3-7.9 s and k = 200 24-30 s -> 23-24 s. Without the null space locked
+  out, the square is unusable: ``1 / shift^2`` exceeds the wanted values by
+  twelve orders of magnitude on that torus and rounding lost eigenpairs
+  (the 200th eigenvalue came out 157.9 where it is 157.6). LOBPCG
   (its Rayleigh-Ritz step on 3k vectors costs n (3k)^2 per iteration) and
   Vallet and Levy's band-by-band shift-invert (each band needs a factorisation
   of the indefinite ``S - sigma I``, which the Cholesky binding cannot do;
@@ -106,7 +123,7 @@ def solve_seconds(n, k):
     return factor_seconds(n) + 0.3 * (n / 10_000) ** 1.2 * (k / 50) ** 0.8
 
 
-def smallest_eigenpairs(S, k, shift, method="auto", tol=1e-10):
+def smallest_eigenpairs(S, k, shift, method="auto", tol=1e-10, null=None):
     """The k smallest eigenpairs of a sparse symmetric positive semidefinite S (n, n).
 
     Parameters
@@ -115,15 +132,25 @@ def smallest_eigenpairs(S, k, shift, method="auto", tol=1e-10):
     k : int, 1 <= k <= n
     shift : float > 0
         ``S + shift I`` is factorised and the Lanczos iteration runs on its
-        inverse, whose largest eigenvalues ``1 / (lam + shift)`` belong to the
-        smallest ``lam``. Must be far below the smallest non-zero eigenvalue
-        and far above rounding.
+        inverse, or with ``null`` on the square of its inverse, whose largest
+        eigenvalues ``1 / (lam + shift)^2`` belong to the smallest ``lam``.
+        Must be far below the smallest non-zero eigenvalue and far above
+        rounding.
     method : "auto", "dense" or "sparse"
         "auto": dense when ``n <= DENSE_MAX`` or k > n / 3, sparse otherwise.
     tol : float
         Relative residual the sparse solve reaches, ``||S y - lam y|| <= tol
         ||S + shift I||`` (see :func:`shift_invert_lanczos`); the eigenvalues
         are then accurate to about ``tol^2`` relative.
+
+    null : (n, z) float64 with orthonormal columns, optional
+        Eigenvectors of S for the eigenvalue 0 that the caller knows (a mesh
+        operator's constants on each component). The sparse solve returns them
+        as they are and keeps them out of its Krylov basis: their
+        ``1 / shift^2``, many orders of magnitude above the wanted
+        ``1 / (lam + shift)^2``, would otherwise swamp those in rounding;
+        so only with ``null`` does the solve use the square (module
+        docstring). The dense solve finds them itself and ignores ``null``.
 
     Returns
     -------
@@ -139,17 +166,24 @@ def smallest_eigenpairs(S, k, shift, method="auto", tol=1e-10):
         with Stages(["factorising", "Lanczos iterations"], solve_seconds(n, k), f"{k} eigenpairs") as bar:
             shifted = factorise(S + shift * sp.eye(n, format="csr"))
             bar.next()
-            Y = shift_invert_lanczos(shifted.solve, n, k, tol)
+            Z = np.zeros((n, 0)) if null is None else null[:, :k]
+            # (S + shift I)^-2 doubles the relative gaps; safe only once the 1 / shift^2 of the null space is out
+            squared = lambda B: shifted.solve(shifted.solve(B))
+            op = shifted.solve if null is None else squared
+            Y = Z if k == Z.shape[1] else np.hstack([Z, shift_invert_lanczos(op, n, k - Z.shape[1], tol, Z)])
             lam = np.einsum("ij,ij->j", Y, S @ Y)  # Rayleigh quotients: error quadratic in the residual
     order = np.argsort(lam, kind="stable")
     return lam[order], Y[:, order]
 
 
-def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
+def shift_invert_lanczos(solve, n, k, tol=1e-10, locked=None, block=BLOCK):
     """Eigenvectors X (n, k), ``X^T X = I``, of the k largest eigenvalues of ``solve`` (a symmetric positive definite operator).
 
     ``solve(B)`` applies the operator to an (n, b) block: here ``(S + shift
-    I)^-1`` by one Cholesky factorisation. Block Lanczos with full
+    I)^-2`` by two solves with one Cholesky factorisation. ``locked`` (n, z),
+    orthonormal columns, are eigenvectors known already: X is found
+    orthogonal to them (the start block and every new block are cleared of
+    them). Block Lanczos with full
     reorthogonalisation and no restart (Golub and Underwood 1977): the Krylov
     basis ``Q`` grows by ``block`` columns per solve, each new block is
     orthogonalised against the last two (the three-term recurrence), then once
@@ -157,7 +191,10 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
     the Ritz pairs of the block-tridiagonal ``T = Q^T solve Q`` are checked
     every few blocks. A Ritz pair ``(theta, x)`` is accepted when the residual
     ``||solve x - theta x||`` is at most ``tol * theta``; for ``solve = (S +
-    shift I)^-1`` that bounds ``||S x - lam x||`` by ``tol ||S + shift I||``.
+    shift I)^-1`` that bounds ``||S x - lam x||`` by ``tol ||S + shift I||``,
+    and for its square the residuals reached were at rounding level too
+    (``max |C E + M E diag(lam)| / max |C|`` about 1e-13 on notebook 04's
+    creature).
     A block of ``block`` vectors resolves eigenvalues of that multiplicity
     (an icosphere has 5-fold ones); the start block is random with a fixed seed.
     """
@@ -165,7 +202,9 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
     rng = np.random.default_rng(0)
     Q = np.empty((n, min(n, 3 * k + 30 * int(np.sqrt(k)) + 4 * b)), order="F")  # untouched columns cost no memory
     T = np.zeros((Q.shape[1] + b, Q.shape[1] + b))
-    Qj = la.qr(rng.uniform(-1.0, 1.0, (n, b)), mode="economic")[0]
+    Z = np.zeros((n, 0)) if locked is None else locked
+    start = rng.uniform(-1.0, 1.0, (n, b))
+    Qj = la.qr(start - Z @ (Z.T @ start), mode="economic")[0]
     j, check, last = 0, k + 6 * np.sqrt(k) + 2 * b, None
     while True:
         if j + b > Q.shape[1]:  # grow the basis by half
@@ -182,14 +221,14 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, block=BLOCK):
         T[j : j + b, j : j + b] = A
         P = Q[:, : j + b]
         before = np.einsum("ij,ij->i", W, W)
-        W -= (W @ P) @ P.T
+        W -= (W @ P) @ P.T + (W @ Z) @ Z.T
         if np.any(np.einsum("ij,ij->i", W, W) < 0.5 * before):  # cancellation: orthogonalise again
-            W -= (W @ P) @ P.T
+            W -= (W @ P) @ P.T + (W @ Z) @ Z.T
         Qj, B = la.qr(W.T, mode="economic", check_finite=False)
         j += b
         T[j : j + b, j - b : j] = B
         T[j - b : j, j : j + b] = B.T
-        full = j + b > n
+        full = j + b > n - Z.shape[1]
         if j >= check or full:
             band = np.array([np.pad(np.diagonal(T[:j, :j], -d), (0, d)) for d in range(b + 1)])
             theta, U = la.eig_banded(band, lower=True, select="i", select_range=(j - k, j - 1), check_finite=False)
