@@ -578,6 +578,32 @@ def test_not_positive_definite_is_a_clear_error():
         factorise(sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]])))
 
 
+def test_an_equal_matrix_gets_the_kept_factorisation_and_a_changed_one_a_new_one():
+    from geomlib.numerics import factor
+
+    V, F = icosphere(2)
+    M, C = laplacian(V, F)
+    A = (M - 0.1 * C).tocsr()
+    kept = factor.factorise(A)
+    b = np.random.default_rng(3).standard_normal((len(V), 3))
+    np.testing.assert_allclose(A @ kept.solve(b), b, atol=1e-10)
+    assert factor.factorise(A.copy()) is kept and factor.factorise(A.tocoo()) is kept  # by content, any format
+    B = A.copy()
+    B.data[0] *= 1.0 + 1e-12
+    changed = factor.factorise(B)
+    assert changed is not kept
+    np.testing.assert_allclose(B @ changed.solve(b), b, atol=1e-10)
+    for s in range(factor.CACHE_SIZE):  # others push the first one out
+        factor.factorise((M - (1.0 + s) * C).tocsr())
+    assert factor.factorise(A) is not kept
+
+
+def test_a_rebuilt_run_starts_with_the_fixed_operators_step():
+    V, F = icosphere(2)
+    V = V + 0.01 * np.random.default_rng(4).standard_normal(V.shape)
+    np.testing.assert_array_equal(implicit_smoothing(V, F, 0.05, 1, rebuild=True), implicit_smoothing(V, F, 0.05, 1))
+
+
 @pytest.mark.parametrize(
     "call",
     [

@@ -65,15 +65,10 @@ def folder(cache_dir=None):
     return Path(root).expanduser() / "spectral"
 
 
-@functools.cache
-def _version():
-    return version("geomlib")  # read once: the installed metadata is searched on every call (about 1 ms)
-
-
 def key(*parts):
     """Hex digest of ``parts`` (arrays by their bytes, shape and dtype, anything else by its repr),
     the geomlib version and the cache format: the one key of every cache in geomlib."""
-    h = hashlib.blake2b(repr((_version(), FORMAT)).encode(), digest_size=16)
+    h = hashlib.blake2b(_salt(), digest_size=16)
     for part in parts:
         if isinstance(part, np.ndarray):
             h.update(repr((part.shape, part.dtype.str)).encode())
@@ -81,6 +76,13 @@ def key(*parts):
         else:
             h.update(repr(part).encode())
     return h.hexdigest()
+
+
+@functools.cache
+def _salt():
+    # the installed version is read from the package metadata once: 1 ms a call, and
+    # the operator and factorisation caches ask for a key at every smoothing call
+    return repr((version("geomlib"), FORMAT)).encode()
 
 
 def clear(cache_dir=None, memory=True):

@@ -22,13 +22,30 @@ vertices   cholespy            splu (COLAMD)
 40,962     0.89 s / 18 ms      2.3 s / 53 ms
 163,842    7.0 s / 64 ms       19.9 s / 1.2 s
 =========  ==================  ==================
+
+The last :data:`CACHE_SIZE` factorisations are kept in memory under a hash of
+the matrix's entries, so the same matrix met again costs a hash instead of a
+factorisation. Notebook 06 meets it often: the first step of a rebuilt-operator
+run has the fixed operator's matrix, a slider's step value was often used by an
+earlier cell. On a reader's 200k-vertex mesh a factorisation takes 2-4 s and
+the hash 20 ms; there notebook 06 finds 4 of its 24 factorisations in the cache
+(benchmarks/bench_large_mesh.py), and 7 of 85 with its own meshes.
 """
+
+from collections import OrderedDict
 
 import numpy as np
 import scipy.sparse as sp
 from cholespy import CholeskySolverD, MatrixType
 
-__all__ = ["Factor", "factorise", "factor_seconds"]
+from . import cache
+
+__all__ = ["Factor", "factorise", "factor_seconds", "CACHE_SIZE"]
+
+#: Factorisations kept in memory (CHOLMOD's factor of a 200k-vertex mesh is about 100 MB).
+CACHE_SIZE = 2
+
+_FACTORS = OrderedDict()
 
 
 def factor_seconds(n):
@@ -47,12 +64,11 @@ class Factor:
     """
 
     def __init__(self, A):
-        A = sp.csr_matrix(A, dtype=np.float64)
+        A = _canonical(A)
         self.n = A.shape[0]
         if self.n == 0:
             self._solver = None
             return
-        A.sum_duplicates()
         try:
             self._solver = CholeskySolverD(
                 self.n,
@@ -73,6 +89,20 @@ class Factor:
         return X
 
 
+def _canonical(A):
+    """A as CSR float64 with sorted, summed entries: equal matrices get equal arrays."""
+    A = sp.csr_matrix(A, dtype=np.float64)
+    A.sum_duplicates()
+    return A
+
+
 def factorise(A):
-    """Factorise the sparse symmetric positive definite matrix A (see :class:`Factor`)."""
-    return Factor(A)
+    """Factorise the sparse symmetric positive definite matrix A (see :class:`Factor`),
+    or hand back the factorisation of an equal matrix kept from before (module docstring)."""
+    A = _canonical(A)
+    name = cache.key(A.shape, A.indptr, A.indices, A.data)
+    factor = _FACTORS.pop(name, None) or Factor(A)
+    _FACTORS[name] = factor  # most recently used last
+    while len(_FACTORS) > CACHE_SIZE:
+        _FACTORS.popitem(last=False)
+    return factor

@@ -111,15 +111,22 @@ class MeshSteps:
         self.values = {name: float(given.get(name, min(values))) for name in meshes}
         # a slider for every mesh at once shows STEP itself, or with one step per mesh a factor on each
         self.reference = 1.0 if self.per_mesh else float(step)
+        self._unit_steps = {}  # name -> the tau of a step of 1 in the unit (ell^2 costs 85 ms at 200k vertices)
 
     def tau(self, name):
         """The absolute step tau of mesh ``name`` (length^2 with cotangent weights)."""
         return self.absolute(name, self.values[name])
 
     def absolute(self, name, value):
-        """The absolute step of mesh ``name`` for a step ``value`` given in the unit (:func:`absolute_step`)."""
-        V, F = self.meshes[name]
-        return absolute_step(value, self.unit, V, F)
+        """The absolute step of mesh ``name`` for a step ``value`` given in the unit (:func:`absolute_step`).
+
+        The conversion is linear, so the mesh's step of 1 is measured once and scaled
+        (a slider callback converts at every move).
+        """
+        if name not in self._unit_steps:
+            V, F = self.meshes[name]
+            self._unit_steps[name] = absolute_step(1.0, self.unit, V, F)
+        return float(value) * self._unit_steps[name]
 
     def at(self, name, position):
         """The absolute step of mesh ``name`` at a ``position`` of :meth:`slider`."""

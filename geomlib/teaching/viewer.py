@@ -572,6 +572,7 @@ class MeshView:
             up=self._up,
             distance=(distance or self._distance) / self._scale,
             centre=self._centre,
+            cull_back=self.closed,
         )
         lo, hi = self.range
         lut = self._lut if self._values is not None and not self.is_zero else None
