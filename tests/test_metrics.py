@@ -480,3 +480,38 @@ def test_sweep_records_what_a_direct_run_gives():
     assert best["rms"] == np.nanmin(R.values["rms"][1])
     assert best["iterations"] == R.iterations[l]
     assert R.best(1, schemes=[("explicit", "cotan")])["method"] == "explicit"
+
+
+@pytest.mark.parametrize("how", ["raises", "dies"])
+def test_a_failed_sweep_worker_is_reported_not_waited_for(monkeypatch, how):
+    """The forked worker of smoothing_sweep raising, or dying without a word (killed, out of
+    memory): the sweep raises a MeshError that says so, instead of hanging on the pipe."""
+    import os
+
+    import geomlib.teaching.sweep as sweep_module
+    from geomlib import MeshError, smoothing_sweep
+
+    parent, real = os.getpid(), sweep_module._sweep_levels
+
+    def failing_in_the_worker(*args):
+        if os.getpid() != parent:
+            if how == "dies":
+                os._exit(3)
+            raise RuntimeError("no memory left")
+        return real(*args)
+
+    monkeypatch.setattr(sweep_module, "_sweep_levels", failing_in_the_worker)
+    V, F = icosphere(1)
+    expected = "exit code 3" if how == "dies" else "RuntimeError: no memory left"
+    with pytest.raises(MeshError, match=expected):
+        smoothing_sweep(
+            V,
+            F,
+            [0.002, 0.01],
+            seed=3,
+            explicit_fractions=(0.5,),
+            implicit_steps=(1.0,),
+            iterations=(1, 2),
+            progress=False,
+            workers=2,
+        )

@@ -8,6 +8,7 @@ the smoothers of :mod:`geomlib.lessons.smoothing` and the metrics of
 """
 
 import multiprocessing
+import os
 import sys
 import time
 import warnings
@@ -52,8 +53,9 @@ IMPLICIT_STEPS = (0.1, 0.3, 1.0)
 SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
 
 #: Processes a sweep runs its noise levels in (:func:`smoothing_sweep`): the levels are
-#: independent, and the machines the workbook is measured on have 2 cores.
-WORKERS = 2
+#: independent; two where this process may use two cores or more (the machines the workbook
+#: is measured on have 2), else one.
+WORKERS = min(2, len(os.sched_getaffinity(0))) if hasattr(os, "sched_getaffinity") else 1
 
 #: The fork context of multiprocessing on Linux; None elsewhere (Windows cannot fork, and on
 #: macOS system libraries may crash in a forked child), where a sweep runs in one process.
@@ -313,11 +315,20 @@ def _with_a_worker(sweep, levels, out, bar):
 
     worker = _FORK.Process(target=work, daemon=True)
     worker.start()
+    send.close()  # the worker holds the only write end now: if it dies, recv() ends instead of waiting forever
     try:
         sweep(mine, bar)
-        kind, result, cpu = receive.recv()
+        try:
+            kind, result, cpu = receive.recv()
+        except EOFError:
+            kind, result, cpu = (
+                "error",
+                f"it ended without an answer (exit code {worker.join() or worker.exitcode})",
+                0.0,
+            )
     finally:
         worker.join()
+        receive.close()
     if kind == "error":
         raise MeshError(f"the smoothing sweep's worker process failed: {result}")
     out.steps[theirs], rows = result
