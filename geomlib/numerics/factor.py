@@ -40,7 +40,7 @@ from cholespy import CholeskySolverD, MatrixType
 
 from . import cache
 
-__all__ = ["Factor", "factorise", "factor_seconds", "CACHE_SIZE"]
+__all__ = ["Factor", "factorise", "factor_seconds", "forget_factorisations", "CACHE_SIZE"]
 
 #: Factorisations kept in memory (CHOLMOD's factor of a 200k-vertex mesh is about 100 MB).
 CACHE_SIZE = 2
@@ -106,3 +106,8 @@ def factorise(A):
     while len(_FACTORS) > CACHE_SIZE:
         _FACTORS.popitem(last=False)
     return factor
+
+
+def forget_factorisations():
+    """Empty the memory of :func:`factorise`, so that the next call factorises (benchmarks time that)."""
+    _FACTORS.clear()

@@ -8,7 +8,6 @@ the smoothers of :mod:`geomlib.lessons.smoothing` and the metrics of
 """
 
 import multiprocessing
-import os
 import sys
 import time
 import warnings
@@ -21,6 +20,7 @@ from ..lessons.noise import add_noise
 from ..lessons.smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit
 from ..mesh.errors import MeshError, MeshWarning
 from ..mesh.validate import check_choice
+from ..numerics.cores import CORES
 from .steps import absolute_step
 
 __all__ = [
@@ -53,9 +53,9 @@ IMPLICIT_STEPS = (0.1, 0.3, 1.0)
 SWEEP_ITERATIONS = (1, 2, 3, 5, 8, 13, 20, 30, 50)
 
 #: Processes a sweep runs its noise levels in (:func:`smoothing_sweep`): the levels are
-#: independent; two where this process may use two cores or more (the machines the workbook
-#: is measured on have 2), else one.
-WORKERS = min(2, len(os.sched_getaffinity(0))) if hasattr(os, "sched_getaffinity") else 1
+#: independent; two where this process may use two cores (the machines the workbook is
+#: measured on have 2), else one.
+WORKERS = min(2, CORES)
 
 #: The fork context of multiprocessing on Linux; None elsewhere (Windows cannot fork, and on
 #: macOS system libraries may crash in a forked child), where a sweep runs in one process.
