@@ -52,7 +52,11 @@
   7.3-7.9 s and k = 200 24-30 s -> 23-24 s. Without the null space locked
   out, the square is unusable: ``1 / shift^2`` exceeds the wanted values by
   twelve orders of magnitude on that torus and rounding lost eigenpairs
-  (the 200th eigenvalue came out 157.9 where it is 157.6). LOBPCG
+  (the 200th eigenvalue came out 157.9 where it is 157.6). Blocks of 4
+  instead of 8 for at most ``FEW`` = 100 pairs: at k = 50, 0.18-0.24 s ->
+  0.13-0.15 s at 10k vertices, 0.98 s -> 0.74-0.83 s at 40k and 4.3-4.5 s
+  -> 3.3 s at 160k; at k = 200 they were slower (40k: 3.7 s -> 3.9 s).
+  The basis products run on two threads (:class:`RowThreads`). LOBPCG
   (its Rayleigh-Ritz step on 3k vectors costs n (3k)^2 per iteration) and
   Vallet and Levy's band-by-band shift-invert (each band needs a factorisation
   of the indefinite ``S - sigma I``, which the Cholesky binding cannot do;
@@ -107,8 +111,10 @@ __all__ = [
 #: Matrices of at most this size are solved with dense LAPACK.
 DENSE_MAX = 600
 
-#: Block size of the Lanczos iteration (:func:`shift_invert_lanczos`).
+#: Block size of the Lanczos iteration (:func:`shift_invert_lanczos`) for more than
+#: :data:`FEW` eigenpairs; half of it for at most :data:`FEW`.
 BLOCK = 8
+FEW = 100
 
 #: Threads the products of :func:`shift_invert_lanczos` with its basis run on (module docstring).
 THREADS = min(2, CORES)
@@ -232,7 +238,7 @@ class RowThreads:
         return X
 
 
-def shift_invert_lanczos(solve, n, k, tol=1e-10, locked=None, block=BLOCK):
+def shift_invert_lanczos(solve, n, k, tol=1e-10, locked=None, block=None):
     """Eigenvectors X (n, k), ``X^T X = I``, of the k largest eigenvalues of ``solve`` (a symmetric positive definite operator).
 
     ``solve(B)`` applies the operator to an (n, b) block: here ``(S + shift
@@ -251,10 +257,14 @@ def shift_invert_lanczos(solve, n, k, tol=1e-10, locked=None, block=BLOCK):
     and for its square the residuals reached were at rounding level too
     (``max |C E + M E diag(lam)| / max |C|`` about 1e-13 on notebook 04's
     creature).
-    A block of ``block`` vectors resolves eigenvalues of that multiplicity
-    (an icosphere has 5-fold ones); the start block is random with a fixed seed.
+    A block of ``block`` vectors (default :data:`BLOCK`, half of it for at most
+    :data:`FEW` pairs) resolves eigenvalues of that multiplicity for sure;
+    higher ones were found too wherever measured (an icosphere's 7-fold at
+    k = 50 with blocks of 4, the 6-fold of the tests), since rounding brings
+    every direction into a fully reorthogonalised basis. The start block is
+    random with a fixed seed.
     """
-    b = min(block, k)
+    b = min(block or (BLOCK if k > FEW else BLOCK // 2), k)
     rng = np.random.default_rng(0)
     Q = np.empty((n, min(n, 3 * k + 30 * int(np.sqrt(k)) + 4 * b)), order="F")  # untouched columns cost no memory
     T = np.zeros((Q.shape[1] + b, Q.shape[1] + b))
