@@ -439,30 +439,12 @@ def test_sweep_records_what_a_direct_run_gives():
     from geomlib.teaching.sweep import smoothing_sweep
 
     V, F = icosphere(2)
-    R = smoothing_sweep(
-        V,
-        F,
-        [0.002, 0.01],
-        seed=3,
-        explicit_fractions=(0.25, 0.5),
-        implicit_steps=(0.1, 1.0),
-        iterations=(1, 3, 5),
-        progress=False,
-    )
+    settings = dict(seed=3, explicit_fractions=(0.25, 0.5), implicit_steps=(0.1, 1.0), iterations=(1, 3, 5))
+    R = smoothing_sweep(V, F, [0.002, 0.01], progress=False, **settings)
     assert R.values["rms"].shape == (2, 4, 2, 3)
     assert not np.isnan(R.values["rms"]).any()
     # the second noise level ran in the worker process (on Linux): the same numbers as in this one
-    serial = smoothing_sweep(
-        V,
-        F,
-        [0.002, 0.01],
-        seed=3,
-        explicit_fractions=(0.25, 0.5),
-        implicit_steps=(0.1, 1.0),
-        iterations=(1, 3, 5),
-        progress=False,
-        workers=1,
-    )
+    serial = smoothing_sweep(V, F, [0.002, 0.01], progress=False, workers=1, **settings)
     for key in R.values:
         np.testing.assert_array_equal(R.values[key], serial.values[key], err_msg=key)
         np.testing.assert_array_equal(R.noisy[key], serial.noisy[key], err_msg=key)
