@@ -116,8 +116,10 @@ DENSE_MAX = 600
 BLOCK = 8
 FEW = 100
 
-#: Threads the products of :func:`shift_invert_lanczos` with its basis run on (module docstring).
+#: Threads the products of :func:`shift_invert_lanczos` with its basis run on (module docstring),
+#: for bases of at least SPLIT entries.
 THREADS = min(2, CORES)
+SPLIT = 1_000_000
 
 _CONTROLLER = None
 
@@ -218,23 +220,28 @@ class RowThreads:
         if self.pool is not None:
             self.pool.shutdown()
 
-    def map(self, f):
-        """``[f(rows) for rows in parts]``, the parts on the threads."""
-        return list(self.pool.map(f, self.parts) if self.pool is not None else map(f, self.parts))
+    def map(self, f, size):
+        """``[f(rows) for rows in parts]``, the parts on the threads; one part, here, below
+        :data:`SPLIT` entries of the tall matrix (10k x 60: 0.79 ms on one thread, 0.88 ms on two;
+        10k x 150: 2.8 ms against 1.6 ms)."""
+        if self.pool is None or size < SPLIT:
+            return [f(slice(None))]
+        return list(self.pool.map(f, self.parts))
 
     def project_out(self, W, *bases):
         """``W -= (W B) B^T`` in place for each basis B (n, j) with orthonormal columns; W is (b, n)."""
-        H = [sum(self.map(lambda s: W[:, s] @ B[s])) for B in bases]
+        size = sum(B.size for B in bases)
+        H = [sum(self.map(lambda s: W[:, s] @ B[s], size)) for B in bases]
 
         def subtract(s):
             W[:, s] -= sum(h @ B[s].T for h, B in zip(H, bases))
 
-        self.map(subtract)
+        self.map(subtract, size)
 
     def product(self, Q, U):
         """``Q @ U`` for a tall Q (n, j) and U (j, k)."""
         X = np.empty((Q.shape[0], U.shape[1]))
-        self.map(lambda s: np.matmul(Q[s], U, out=X[s]))
+        self.map(lambda s: np.matmul(Q[s], U, out=X[s]), Q.size)
         return X
 
 
