@@ -18,10 +18,12 @@
   ``benchmarks/bench_spectral.py`` against ``eigsh`` with one BLAS thread
   (2 cores shared with other work, load average 3-6, one run each): 0.59x at
   10k vertices, k = 50; 0.32x at 10k and 40k, k = 200; 0.26x at 160k, k = 200
-  (37 s against 139 s); in the saved run on a quiet machine (load average
-  1.0-1.4) 0.65x, 0.29x, 0.37x, 0.25x, 0.36x and 0.25x at 10k, 40k and 160k
-  vertices for k = 50 and 200 (0.06x to 0.41x against the default two
-  threads); with the orthogonalisation still written as
+  (37 s against 139 s); in the saved run on a quiet machine before the
+  changes below (load average 1.0-1.4) 0.65x, 0.29x, 0.37x, 0.25x, 0.36x and
+  0.25x at 10k, 40k and 160k vertices for k = 50 and 200; with them, in
+  ``benchmarks/bench_spectral.json``, 0.43x, 0.27x, 0.36x, 0.26x, 0.36x and
+  0.26x (0.50x, 0.35x, 0.39x, 0.31x, 0.39x and 0.34x against the default two
+  threads; the cold k = 200 at 25.6k vertices 4.7 s -> 2.6 s); with the orthogonalisation still written as
   ``(n, j) @ (j, b)``, 0.34x at 40k and 0.32x at 160k for k = 50. The new
   block is kept as rows, ``(b, n)``: at 160k vertices ``W @ Q`` and
   ``(W @ Q) @ Q.T`` read the basis at memory speed, ``Q @ h`` three to four
