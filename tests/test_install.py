@@ -40,7 +40,7 @@ ROOT = Path(__file__).resolve().parents[1]
 EXISTING = {
     "jupyterlab": "4.5.11",
     "notebook": "7.5.8",
-    "ipykernel": "6.31.0",
+    "ipykernel": "6.30.1",
     "ipywidgets": "8.1.8",
     "jupyterlab-widgets": "3.0.16",
     "widgetsnbextension": "4.0.15",
