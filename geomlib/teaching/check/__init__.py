@@ -11,6 +11,6 @@ from .denoising import *  # noqa: F401,F403
 from .explicit import *  # noqa: F401,F403
 from .forms import *  # noqa: F401,F403
 from .implicit import *  # noqa: F401,F403
-from .result import CheckFailed, CheckResult, Mistake, use  # noqa: F401
+from .result import CheckFailed, CheckResult, Mistake, reveal, use  # noqa: F401
 from .spectral import *  # noqa: F401,F403
 from .uniform import *  # noqa: F401,F403

@@ -64,7 +64,17 @@ def _wrong_angle_variants(V, F):
     ]
 
 
-@exercise("cotangent_laplacian", reread=_REREAD_C)
+@exercise(
+    "cotangent_laplacian",
+    reread=_REREAD_C,
+    forbid=(
+        "lessons.laplace.cotangent_matrix",
+        "lessons.laplace.laplacian",
+        "lessons.laplace.barycentric_areas",
+        "lessons.laplace.vertex_areas",
+    ),
+    own=("lessons.laplace.cotangent_matrix",),
+)
 def cotangent_laplacian(fn):
     """Check ``fn(V, F) -> (M, C)``: C_ij = (cot alpha_ij + cot beta_ij) / 2, C_ii = -sum_j C_ij, M barycentric."""
     checked = []
@@ -144,7 +154,16 @@ def _areas(fn, V, F, what):
     return vector(out, len(V), what)
 
 
-@exercise("vertex_areas", reread=_REREAD_A)
+@exercise(
+    "vertex_areas",
+    reread=_REREAD_A,
+    forbid=(
+        "lessons.laplace.barycentric_areas",
+        "lessons.laplace.vertex_areas",
+        "lessons.laplace.laplacian",
+        "lessons.laplace.measured_areas",
+    ),
+)
 def vertex_areas(fn):
     """Check ``fn(V, F) -> (n,)`` barycentric vertex areas: A_i = 1/3 of the incident triangle areas."""
     checked = []
@@ -184,7 +203,16 @@ def _per_corner_sum(n, F, pieces):
     return np.bincount(F.ravel(), weights=pieces.ravel(), minlength=n)
 
 
-@exercise("mixed_areas", reread=_REREAD_A)
+@exercise(
+    "mixed_areas",
+    reread=_REREAD_A,
+    forbid=(
+        "lessons.laplace.mixed_areas",
+        "lessons.laplace.vertex_areas",
+        "lessons.laplace.laplacian",
+        "lessons.laplace.measured_areas",
+    ),
+)
 def mixed_areas(fn):
     """Check ``fn(V, F) -> (n,)`` mixed areas (Meyer et al. 2003): Voronoi, or A/2 and A/4 in obtuse triangles."""
     checked = []

@@ -94,7 +94,7 @@ def _scale_mistakes(d, ell, sigma):
     ]
 
 
-@exercise("add_noise", reread=NOISE_SECTION)
+@exercise("add_noise", reread=NOISE_SECTION, forbid=("lessons.noise.add_noise",))
 def add_noise(fn):
     """Check ``fn(V, F, sigma, seed) -> V'``: V + sigma * d * (independent standard normals)."""
     V, F = _NOISE_V, _NOISE_F
@@ -239,7 +239,11 @@ def _rms_mistakes(V, V_clean):
     ]
 
 
-@exercise("vertex_rms", reread=RMS_SECTION)
+@exercise(
+    "vertex_rms",
+    reread=RMS_SECTION,
+    forbid=("lessons.metrics.vertex_rms", "lessons.metrics.denoising_metrics", "lessons.metrics.MeshComparison"),
+)
 def vertex_rms(fn):
     """Check ``fn(V, V_clean) -> float``: sqrt(mean_i |x_i - x_i^clean|^2) / d(V_clean)."""
     checked = []

@@ -50,7 +50,15 @@ def positions(out, n, what="the function"):
     return P.astype(float)
 
 
-@exercise("explicit_step", reread=_REREAD_STEP)
+@exercise(
+    "explicit_step",
+    reread=_REREAD_STEP,
+    forbid=(
+        "lessons.smoothing.explicit_step",
+        "lessons.smoothing.explicit_smoothing",
+        "lessons.smoothing.ExplicitSmoother",
+    ),
+)
 def explicit_step(fn):
     """Check ``fn(P, M, C, tau) -> P'`` = P + tau M^-1 C P (forward Euler on dP/dt = Delta P)."""
     checked = []
@@ -106,7 +114,15 @@ def _lam(A, M):
     return scipy.linalg.eigh(A.toarray(), M.toarray(), eigvals_only=True)
 
 
-@exercise("explicit_step_limit", reread=_REREAD_LIMIT)
+@exercise(
+    "explicit_step_limit",
+    reread=_REREAD_LIMIT,
+    forbid=(
+        "lessons.smoothing.explicit_step_limit",
+        "lessons.smoothing.highest_frequency_mode",
+        "numerics.eigen.largest_eigenvalue",
+    ),
+)
 def explicit_step_limit(fn):
     """Check ``fn(V, F) -> tau_max`` = 2 / lam_max, lam_max the largest eigenvalue of -M^-1 C
     for the cotangent operator ``(M, C) = laplacian(V, F)`` (closed meshes: no boundary rule)."""

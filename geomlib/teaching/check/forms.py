@@ -91,7 +91,9 @@ def _same(x, y):
 
 
 @exercise(
-    "fundamental_forms", reread="Steps 2 to 4 · the first fundamental form, the normal and the second fundamental form"
+    "fundamental_forms",
+    reread="Steps 2 to 4 · the first fundamental form, the normal and the second fundamental form",
+    forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
 )
 def fundamental_forms(fn):
     """Check ``fn(a, b, c, u, v) -> (E, F, G, e, f, g)`` (or ``(I, II)``) for the ellipsoid, by value."""
@@ -165,7 +167,15 @@ _AXES = np.array([[1.0, 0.7, 0.5], [2.0, 1.5, 0.8], [1.3, 0.6, 1.9]])
 _PHIS = np.array([0.0, 0.4, 1.1, np.pi / 2, 2.5, 4.0])
 
 
-@exercise("normal_curvature", reread="Step 6 · The normal curvature kappa_n(phi)")
+@exercise(
+    "normal_curvature",
+    reread="Step 6 · The normal curvature kappa_n(phi)",
+    forbid=(
+        "lessons.symbolic.ellipsoid_normal_curvature",
+        "lessons.symbolic.ParametricSurface",
+        "lessons.symbolic.ellipsoid",
+    ),
+)
 def normal_curvature(fn):
     """Check ``fn(a, b, c, phi) -> kappa_n`` at (a, 0, 0), phi in radians from p_u (numbers or sympy numbers)."""
     got = np.empty((len(_AXES), len(_PHIS)))

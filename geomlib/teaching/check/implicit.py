@@ -21,7 +21,15 @@ def _solve(A, B):
     return sla.spsolve(sp.csc_matrix(A), B)
 
 
-@exercise("implicit_step", reread=_REREAD)
+@exercise(
+    "implicit_step",
+    reread=_REREAD,
+    forbid=(
+        "lessons.smoothing.implicit_step",
+        "lessons.smoothing.implicit_smoothing",
+        "lessons.smoothing.ImplicitSmoother",
+    ),
+)
 def implicit_step(fn):
     """Check ``fn(P, M, C, tau) -> P'`` solving (M - tau C) P' = M P."""
     checked = []

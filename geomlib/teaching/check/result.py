@@ -42,7 +42,19 @@ page shows the diagnosis. Each exercise has two grade cells:
   type, an exception or a stub earn nothing.
 
 ``use`` calls ``check.NAME.evaluate(fn)``, which never raises, so the cells after
-an exercise run on geomlib's own function in every mode. Warnings raised by the
+an exercise run on geomlib's own function in every mode.
+
+Ground rules
+------------
+As in Jacobson's geometry-processing assignments, each exercise names the geomlib
+routines its answer may not call: its own routine, and whatever computes the answer
+for it (``exercise(..., forbid=("lessons.laplace.laplacian", ...))``, dotted names
+inside geomlib, a class standing for all its methods). While the learner's function
+runs, a profile hook watches for a call of any of them (through a lambda, a helper,
+a cache or another geomlib routine that calls it); one such call fails the check with
+no points, naming the routine. ``check.NAME.rules`` is the sentence the notebook and
+the grading guide print. ``reveal(fn, check.NAME)`` shows geomlib's own routine only
+once ``fn`` passes, so the page a student is handed never shows the answer. Warnings raised by the
 learner's function while nbgrader grades are silenced: nbgrader scores a grade
 cell that wrote to stderr as failed.
 """
@@ -50,6 +62,9 @@ cell that wrote to stderr as failed.
 import contextlib
 import functools
 import html
+import importlib
+import inspect
+import sys
 import warnings
 
 import numpy as np
@@ -57,7 +72,18 @@ import scipy.sparse as sp
 
 from ..notebook import graded, strict_claims
 
-__all__ = ["CheckResult", "CheckFailed", "Mistake", "exercise", "call", "matrix_pair", "vector", "close", "use"]
+__all__ = [
+    "CheckResult",
+    "CheckFailed",
+    "Mistake",
+    "exercise",
+    "call",
+    "matrix_pair",
+    "vector",
+    "close",
+    "use",
+    "reveal",
+]
 
 
 class CheckFailed(AssertionError):
@@ -126,20 +152,118 @@ class CheckResult:
         display({"text/plain": repr(self), "text/html": self._repr_html_()}, raw=True)
 
 
-def call(fn, *args):
-    """Call the learner's function; turn its exceptions into a diagnosis."""
+def _resolve(dotted):
+    """The object a dotted name inside geomlib stands for ("lessons.laplace.laplacian")."""
+    module, _, name = dotted.rpartition(".")
+    return getattr(importlib.import_module(f"geomlib.{module}"), name)
+
+
+def _entry_points(dotted):
+    """{code object or id of a callable: public name} by which a call of ``dotted`` shows in a profile."""
+    target = _resolve(dotted)
+    members = [m for m in vars(target).values()] if isinstance(target, type) else [target]
+    found = {}
+    for member in members:
+        f = member.fget if isinstance(member, property) else getattr(member, "__func__", member)
+        if not callable(f):
+            continue
+        found[id(f)] = dotted  # a C-level wrapper (functools.lru_cache) shows as a "c_call" of itself
+        code = getattr(inspect.unwrap(f), "__code__", None)
+        if code is not None:
+            found[code] = dotted
+    return found
+
+
+class _Rules:
+    """The ground rules of one exercise: the geomlib routines its answer may not call."""
+
+    def __init__(self, forbid, own):
+        self.forbid, self.own = tuple(forbid), tuple(own)
+        self._watch = None
+
+    def watch(self):
+        if self._watch is None:  # resolved on first use: a check module imports no lesson it forbids
+            self._watch = {}
+            for dotted in self.forbid:
+                self._watch.update(_entry_points(dotted))
+        return self._watch
+
+    def sentence(self):
+        if not self.forbid:
+            return "Any geomlib routine may be used."
+        names = ", ".join(f"`{_public(d)}`" for d in self.forbid)
+        return f"Ground rules: write it with numpy and scipy; do not call geomlib's {names}."
+
+    def refusal(self, dotted):
+        why = (
+            "which this exercise asks you to write"
+            if dotted in self.own
+            else "which computes this exercise's answer for you"
+        )
+        return Mistake(
+            f"the function calls geomlib's `{_public(dotted)}`, {why}, so it earns no points",
+            self.sentence().rstrip("."),
+            typical=False,
+        )
+
+
+def _public(dotted):
+    return dotted.rpartition(".")[2]
+
+
+_RULES = [None]  # the rules of the exercise being checked (checks run one at a time)
+
+
+@contextlib.contextmanager
+def _watching(watch, hits):
+    """Record the first forbidden routine entered while the block runs (sys.setprofile)."""
+
+    def profile(frame, event, arg):
+        if hits:
+            return
+        if event == "call":
+            name = watch.get(frame.f_code)
+        elif event == "c_call":
+            name = watch.get(id(arg))
+        else:
+            return
+        if name is not None:
+            hits.append(name)
+
+    previous = sys.getprofile()
+    sys.setprofile(profile)
     try:
-        return fn(*args)
+        yield
+    finally:
+        sys.setprofile(previous)
+
+
+def call(fn, *args):
+    """Call the learner's function under the exercise's ground rules; turn its exceptions into a diagnosis."""
+    rules, hits = _RULES[0], []
+    try:
+        if rules is not None and rules.forbid:
+            with _watching(rules.watch(), hits):
+                out = fn(*args)
+        else:
+            out = fn(*args)
     except NotImplementedError as exc:
+        if hits:
+            raise rules.refusal(hits[0]) from None
         raise _NotWritten(str(exc)) from None
     except Mistake:
         raise
     except Exception as exc:  # the learner's code may raise anything; name it
+        if hits:
+            raise rules.refusal(hits[0]) from None
         raise Mistake(
             f"the function raised {type(exc).__name__}: {exc}",
             "run it on the small example in the cell above and read the traceback",
             typical=False,
         ) from None
+    if hits:
+        raise rules.refusal(hits[0])
+    return out
 
 
 def _dense(A):
@@ -201,13 +325,20 @@ def _enforce(result):
     return result
 
 
-def exercise(name, reread):
-    """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring)."""
+def exercise(name, reread, forbid=(), own=None):
+    """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
+
+    ``forbid``: dotted names inside geomlib of the routines the answer may not call;
+    ``own``: those of them that are the exercise's own routine, revealed by ``reveal``
+    (default: the first).
+    """
+    rules = _Rules(forbid, forbid[:1] if own is None else own)
 
     def wrap(body):
         def evaluate(fn):
             """The CheckResult of ``fn``; never raises."""
             try:
+                _RULES[0] = rules
                 with _quiet_while_graded():
                     checked = body(fn)
             except _NotWritten as exc:
@@ -219,6 +350,8 @@ def exercise(name, reread):
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
                 return CheckResult(name, False, message, partial=m.typical)
+            finally:
+                _RULES[0] = None
             return CheckResult(name, True, "checked on " + ", ".join(checked) + ".")
 
         @functools.wraps(body)
@@ -239,6 +372,7 @@ def exercise(name, reread):
             return _enforce(CheckResult(f"{name}, partial credit", result.partial, message, written=result.written))
 
         check.exercise, check.reread = name, reread
+        check.forbid, check.own, check.rules = rules.forbid, rules.own, rules.sentence()
         check.evaluate, check.partial_credit = evaluate, partial_credit
         return check
 
@@ -259,3 +393,27 @@ def use(fn, check, reference):
         f"the cells below use geomlib's {reference.__module__}.{reference.__name__}."
     )
     return reference
+
+
+def reveal(fn, check):
+    """geomlib's own routine for an exercise, shown once the learner's ``fn`` passes ``check``.
+
+    Placed after an exercise: the solution version (whose answer passes) shows the
+    routine to compare with; a released assignment shows it only once the student's
+    own function passes, so the page a student is handed never holds the answer.
+    """
+    from IPython.display import display
+
+    from ..notebook import show_source
+
+    result = check.evaluate(fn)
+    if result.passed:
+        print(f"Your {getattr(fn, '__name__', 'function')} passes its check. geomlib's own, to compare with yours:")
+        for dotted in check.own[1:]:
+            display(show_source(_resolve(dotted)))
+        return show_source(_resolve(check.own[0]))
+    print(
+        f"geomlib's own {_public(check.own[0])} is shown here once your "
+        f"{getattr(fn, '__name__', 'function')} passes its check above: write yours first."
+    )
+    return None

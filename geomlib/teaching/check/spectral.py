@@ -54,7 +54,16 @@ def _project(E, W, V):
     return E @ (E.T @ W(V))
 
 
-@exercise("spectral_reconstruction", reread=_REREAD)
+@exercise(
+    "spectral_reconstruction",
+    reread=_REREAD,
+    forbid=(
+        "lessons.spectral.spectral_reconstruction",
+        "lessons.spectral.spectral_basis",
+        "lessons.spectral.SpectralBasis",
+        "lessons.spectral.eigenbasis",
+    ),
+)
 def spectral_reconstruction(fn):
     """Check ``fn(V, F, k) -> V_k``: V_k = E_k E_k^T M V with E_k the first k eigenvectors."""
     V, F, M, C, E = _case()

@@ -16,7 +16,11 @@ _GRID_V = np.array([[x, y, 0.0] for y in range(3) for x in range(3)])
 _GRID_F = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [3, 4, 7], [3, 7, 6], [4, 5, 8], [4, 8, 7]])
 
 
-@exercise("uniform_laplacian", reread="section 2 · The uniform Laplacian, derived")
+@exercise(
+    "uniform_laplacian",
+    reread="section 2 · The uniform Laplacian, derived",
+    forbid=("lessons.laplace.uniform_laplacian", "lessons.laplace.laplacian", "lessons.laplace.uniform_adjacency"),
+)
 def uniform_laplacian(fn):
     """Check ``fn(V, F) -> (M, C)``: C_ij = 1 on edges, C_ii = -valence, M = diag(valence)."""
     checked = []
@@ -78,7 +82,16 @@ def _same(a, b, mask):
     return bool(np.all(np.isfinite(a[mask]))) and close(a[mask], b[mask], rtol=1e-7, atol=1e-9)
 
 
-@exercise("gaussian_curvature", reread="section 3 · Gaussian curvature from the angle deficit")
+@exercise(
+    "gaussian_curvature",
+    reread="section 3 · Gaussian curvature from the angle deficit",
+    forbid=(
+        "lessons.curvature.gaussian_curvature",
+        "lessons.curvature.angle_deficit",
+        "lessons.curvature.angle_sums",
+        "lessons.curvature.angle_and_area_sums",
+    ),
+)
 def gaussian_curvature(fn):
     """Check ``fn(V, F) -> (n,)``: K_i = (2 pi - sum of angles) / (a third of the incident areas), NaN on the boundary."""
     checked = []

@@ -1,0 +1,88 @@
+"""Ground rules: every exercise refuses an answer that calls geomlib's own routine for it.
+
+Each exercise's check names the routines its answer may not call (``check.NAME.forbid``).
+An answer that calls one (directly, through a lambda, or through another geomlib routine
+that calls it) fails with no points and is told which routine and why. ``SHORTCUTS``
+holds, for every exercise of ``geomlib.check``, the shortest such answer: a new exercise
+without one fails ``test_every_exercise_has_a_shortcut_here``.
+"""
+
+import pytest
+
+import geomlib
+import geomlib.lessons.smoothing as smoothing
+import geomlib.lessons.symbolic as symbolic
+from geomlib import check
+from geomlib.teaching.check.result import reveal
+
+SHORTCUTS = {
+    "uniform_laplacian": lambda V, F: geomlib.laplacian(V, F, weights="uniform"),
+    "gaussian_curvature": lambda V, F: geomlib.gaussian_curvature(V, F),
+    "cotangent_laplacian": lambda V, F: geomlib.laplacian(V, F),
+    "vertex_areas": lambda V, F: geomlib.vertex_areas(V, F),
+    "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
+    "spectral_reconstruction": lambda V, F, k: geomlib.spectral_reconstruction(V, F, k, cache=False),
+    "explicit_step": smoothing.explicit_step,
+    "explicit_step_limit": geomlib.explicit_step_limit,
+    "implicit_step": smoothing.implicit_step,
+    "add_noise": geomlib.add_noise,
+    "vertex_rms": geomlib.vertex_rms,
+    "normal_curvature": lambda a, b, c, phi: symbolic.ellipsoid_normal_curvature(a, b, c, phi),
+    "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
+}
+
+
+def exercises():
+    return sorted(name for name in dir(check) if hasattr(getattr(check, name), "evaluate"))
+
+
+def test_every_exercise_has_a_shortcut_here():
+    assert sorted(SHORTCUTS) == exercises()
+
+
+@pytest.mark.parametrize("name", exercises())
+def test_the_geomlib_shortcut_earns_nothing_and_is_named(name):
+    checker = getattr(check, name)
+    assert checker.forbid, f"{name} names no routine its answer may not call"
+    result = checker.evaluate(SHORTCUTS[name])
+    assert not result.passed and not result.partial, result.message
+    assert "calls geomlib's `" in result.message and "earns no points" in result.message, result.message
+    named = result.message.split("`")[1]
+    assert named in {dotted.rpartition(".")[2] for dotted in checker.forbid}
+    assert "Ground rules" in checker.rules and f"`{named}`" in checker.rules
+
+
+def test_a_call_hidden_in_a_helper_is_still_seen():
+    def helper(V, F):
+        return geomlib.mean_curvature(V, F)  # calls laplacian inside
+
+    def answer(V, F):
+        helper(V, F)
+        return geomlib.laplacian(V, F, weights="uniform")
+
+    result = check.uniform_laplacian.evaluate(answer)
+    assert not result.passed and "`laplacian`" in result.message
+
+
+def test_a_numpy_answer_is_not_refused_and_rules_leave_no_profile_behind():
+    import sys
+
+    def explicit_step(P, M, C, tau):
+        return P + tau * (C @ P) / M.diagonal()[:, None]
+
+    assert check.explicit_step.evaluate(explicit_step).passed
+    assert sys.getprofile() is None
+
+
+def test_reveal_waits_for_a_passing_answer(capsys):
+    def stub(P, M, C, tau):
+        raise NotImplementedError
+
+    assert reveal(stub, check.explicit_step) is None
+    assert "once your stub passes" in capsys.readouterr().out
+
+    def explicit_step(P, M, C, tau):
+        return P + tau * (C @ P) / M.diagonal()[:, None]
+
+    shown = reveal(explicit_step, check.explicit_step)
+    assert "M^-1 (C P)" in shown._repr_html_()
