@@ -11,9 +11,9 @@ from importlib import import_module
 
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
-    **dict.fromkeys(["use"], "check"),
+    **dict.fromkeys(["reveal", "use"], "check"),
     **dict.fromkeys(["live", "mesh_warnings"], "controls"),
-    **dict.fromkeys(["claim", "explain", "note", "prepare", "show_source"], "notebook"),
+    **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
     **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "steps"),
     **dict.fromkeys(["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "smoothing_sweep"], "sweep"),
     **dict.fromkeys(["MeshView", "side_by_side"], "viewer"),

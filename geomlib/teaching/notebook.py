@@ -24,6 +24,12 @@ Machinery, not a lesson: nothing here computes geometry.
       "The text says ...; with these inputs ... because ...", and returns
       False, so the notebook keeps going.
 
+``show_figure(fig, alt)``
+    Displays a matplotlib figure as a PNG whose alt text (output metadata
+    ``image/png: {alt: ...}``, and the ``text/plain`` form) says what the figure
+    shows and, for a data plot, what it finds; the website carries it into the
+    page's ``<img alt>``. Closes the figure, so it is shown once.
+
 The runs of notebooks with other inputs (``tests/test_reader_inputs.py``) set
 ``GEOMLIB_STRICT_CLAIMS=0`` and collect the notes, whose ``text/plain`` form starts with ``Note:``.
 """
@@ -42,6 +48,7 @@ from ..mesh.validate import as_mesh
 
 __all__ = [
     "show_source",
+    "show_figure",
     "explain",
     "claim",
     "note",
@@ -127,6 +134,28 @@ def show_source(obj):
     cell shows it once.
     """
     return _Source(obj)
+
+
+def show_figure(fig, alt):
+    """Display ``fig`` (a matplotlib Figure) as a PNG with the alt text ``alt``, then close it.
+
+    ``alt`` says what the figure shows and, for a data plot, what it finds, in a sentence
+    or two built from the numbers plotted (WCAG 2.1, 1.1.1 Non-text content).
+    """
+    import base64
+    import io
+
+    import matplotlib.pyplot as plt
+    from IPython.display import display
+
+    alt = " ".join(str(alt).split())
+    if not alt:
+        raise ValueError("show_figure needs an alt text that says what the figure shows")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", bbox_inches="tight")
+    plt.close(fig)
+    data = base64.b64encode(buffer.getvalue()).decode("ascii")
+    display({"image/png": data, "text/plain": f"Figure: {alt}"}, metadata={"image/png": {"alt": alt}}, raw=True)
 
 
 def _fill(template, values):
