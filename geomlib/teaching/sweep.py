@@ -47,6 +47,8 @@ __all__ = [
     "COMPARISON_GRIDS",
     "DenoisingComparison",
     "denoising_comparison",
+    "plot_comparison",
+    "plot_taubin_factors",
 ]
 
 #: The smoothing methods a scheme can name.
@@ -478,7 +480,11 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     def rows(indices):
         found = {}
         for i, j in (jobs[x] for x in indices):
-            found[i, j] = (out.limits[i, j], {k: v[j][i] for k, v in out.values.items()}, {k: v[i] for k, v in out.noisy.items()})
+            found[i, j] = (
+                out.limits[i, j],
+                {k: v[j][i] for k, v in out.values.items()},
+                {k: v[i] for k, v in out.noisy.items()},
+            )
         return found
 
     def put(found, indices):
@@ -538,3 +544,84 @@ def _taubin(smoother, W, tau, counts, callback):
             if not np.abs(P - W).max() <= far:
                 return
             callback(k, P)
+
+
+def plot_comparison(result, i, key="rms"):
+    """Heat maps of :func:`denoising_comparison` at noise level ``i``: one panel per method.
+
+    Each panel: ``key`` over (step, iteration count), in one unit on every panel (y: the step
+    as a fraction of the explicit limit of the method's operator; x: iterations, Taubin's
+    pairs), as a ratio to the noisy input's ``key`` on one log colour scale for all panels,
+    its best cell ringed and labelled with its value. Returns ``(fig, alt)``, the alt text
+    built from the plotted numbers.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+
+    noisy = result.noisy[key][i]
+    base = noisy if noisy > 0 else 1.0  # without noise (sigma = 0) the values themselves
+    ratios = [np.abs(v[i]) / base for v in result.values[key]]
+    found = np.concatenate([r[np.isfinite(r) & (r > 0)] for r in ratios] + [np.array([1.0])])
+    norm = LogNorm(vmin=float(found.min()), vmax=max(float(found.max()), 10 * float(found.min())))
+    fig, axes = plt.subplots(1, len(result.methods), figsize=(3.6 * len(result.methods), 3.3), squeeze=False)
+    found = []
+    for ax, (method, weights), ratio in zip(axes[0], result.methods, ratios):
+        steps, counts = result.grids[method, weights]
+        im = ax.imshow(ratio, cmap="viridis", norm=norm, aspect="auto", origin="lower")
+        b = result.best(i, (method, weights), key)
+        k, l = b["index"]
+        ax.plot(l, k, "o", ms=14, mfc="none", mec="white", mew=2)
+        ax.annotate(f"{b[key]:.3g}", (l, k), xytext=(0, 11), textcoords="offset points", ha="center", color="white")
+        shown = range(0, len(counts), max(1, len(counts) // 5))
+        ax.set_xticks(list(shown), [str(counts[c]) for c in shown])
+        ax.set_yticks(range(len(steps)), [f"{s:g}" for s in steps])
+        ax.set_xlabel("shrink/inflate pairs" if method == "taubin" else "iterations")
+        ax.set_title(f"{method}, {weights}", fontsize=10)
+        found.append(f"{method} {weights} {b[key]:.3g} at {b['fraction']:g} of the limit, {b['iterations']} iterations")
+    axes[0, 0].set_ylabel("step / explicit limit")
+    fig.colorbar(im, ax=axes, label=f"{key} / noisy input's (log scale)" if noisy > 0 else key, shrink=0.9)
+    fig.suptitle(f"noise sigma = {result.sigmas[i]:g}: error after smoothing over step and iterations")
+    alt = (
+        f"{len(result.methods)} heat maps at noise sigma {result.sigmas[i]:g}, one per method, of the vertex "
+        f"error over the step (as a fraction of the explicit limit) and the iteration count, relative to the "
+        f"noisy input's {noisy:.3g}. Each method's smallest error, inside its grid: " + "; ".join(found) + "."
+    )
+    return fig, alt
+
+
+def plot_taubin_factors(lam_max, tau_shrink, tau_inflate, low):
+    """One Taubin pair against two explicit steps of ``tau_shrink``: the factor per mode over [0, lam_max].
+
+    Lines told apart by style and marker, each labelled; the smooth mode ``low`` marked on both.
+    Returns ``(fig, alt)``, the alt text built from the plotted factors.
+    """
+    import matplotlib.pyplot as plt
+
+    from ..lessons.filters import mode_factor
+
+    lam = np.linspace(0.0, lam_max, 200)
+    pair = mode_factor(lam, tau_shrink, "taubin", tau_inflate)
+    two = mode_factor(lam, tau_shrink, "explicit") ** 2
+    fig, ax = plt.subplots(figsize=(7, 3.4))
+    ax.plot(lam, pair, "-", lw=2, label=f"one Taubin pair ({tau_shrink:g}, {tau_inflate:g})")
+    ax.plot(lam, two, "--", lw=2, label=f"two explicit steps of {tau_shrink:g}")
+    at = [
+        float(mode_factor(low, tau_shrink, "taubin", tau_inflate)),
+        float(mode_factor(low, tau_shrink, "explicit")) ** 2,
+    ]
+    ax.plot([low, low], at, "ko", ms=5)
+    for y, text in zip(at, ("pair", "explicit")):
+        ax.annotate(
+            f"{text}: {y:.3f}", (low, y), xytext=(6, -4 if text == "explicit" else 4), textcoords="offset points"
+        )
+    ax.axhline(0, color="0.5", lw=0.6)
+    ax.set(
+        xlabel=r"eigenvalue $\lambda$ (0: smooth shape, right: fine wiggles)", ylabel="factor kept", xlim=(0, lam_max)
+    )
+    ax.legend(loc="lower left", fontsize=9)
+    alt = (
+        f"Factor kept per mode over the eigenvalues 0 to {lam_max:.3g}: one Taubin pair ({tau_shrink:g}, {tau_inflate:g}) "
+        f"keeps {at[0]:.3f} of the smooth mode at {low:.3g} where two explicit steps keep {at[1]:.3f}; at the top "
+        f"mode the pair keeps {float(pair[-1]):.3f} and the explicit steps {float(two[-1]):.3f}."
+    )
+    return fig, alt

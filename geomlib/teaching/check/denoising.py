@@ -30,8 +30,8 @@ from .result import Mistake, call, exercise
 
 __all__ = ["add_noise", "vertex_rms", "denoising_experiment"]
 
-NOISE_SECTION = "section 2 · The noise model"
-RMS_SECTION = "section 3 · The error"
+NOISE_SECTION = "section 2 · The noise, yours"
+RMS_SECTION = "section 3 · The error, yours"
 EXPERIMENT_SECTION = "section 4 · The experiment, yours"
 
 
@@ -367,6 +367,12 @@ def denoising_experiment(fn):
         )
     other = _number(call(fn, V.copy(), F.copy(), _EXP_SIGMA, tau, _EXP_ITERATIONS, _EXP_SEED + 1), "another seed")
     if other == first:
+        quiet = _number(call(fn, V.copy(), F.copy(), 0.0, tau, _EXP_ITERATIONS, _EXP_SEED), "the call with sigma = 0")
+        if np.isclose(quiet, first, rtol=1e-9, atol=0):
+            raise Mistake(
+                "the error does not depend on the noise at all: the clean mesh was smoothed instead of the noisy one",
+                "smooth W = V_clean + noise, then compare with V_clean",
+            )
         raise Mistake("another seed gave the very same error: the seed is ignored", "pass seed to default_rng(seed)")
     # no smoothing: the error is the noise itself, about sqrt(3) sigma whatever the mesh
     zero = _experiment(V, F, _EXP_SIGMA, tau, 0, _EXP_SEED)
@@ -415,7 +421,14 @@ def denoising_experiment(fn):
     run = _experiment(V, F, *args)
     if not _near(first, run["right"]):
         clean_smoothed = _experiment(V, F, 0.0, tau, _EXP_ITERATIONS, _EXP_SEED)["right"]
+        absolute = _experiment(V, F, _EXP_SIGMA / d, tau, _EXP_ITERATIONS, _EXP_SEED)["right"] * d
         for target, diagnosis, hint in [
+            (
+                absolute,
+                "the noise and the error are not both relative to the bounding-box diagonal: the noise's standard "
+                "deviation is sigma itself and the error is in length units",
+                "noise of standard deviation sigma * d, and the RMS error divided by d",
+            ),
             (
                 run["noisy"],
                 "the error is measured against the noisy mesh, not against the clean mesh, the truth",
