@@ -32,7 +32,9 @@ def front_image():
     w, h = SIZE
     V, F = geomlib.load_mesh(geomlib.data_path("torus.obj"))
     K = geomlib.gaussian_curvature(V, F)
-    torus = MeshView(V, F, K, symmetric=True, width=w, height=h, title="torus: Gaussian curvature", label="K (1/length^2)")
+    torus = MeshView(
+        V, F, K, symmetric=True, width=w, height=h, title="torus: Gaussian curvature", label="K (1/length^2)"
+    )
     V, F = geomlib.load_mesh(geomlib.data_path("cad_part_noisy.obj"))
     noisy = MeshView(V, F, width=w, height=h, title="a noisy part")
     P = geomlib.implicit_smoothing(V, F, step=1e-3, iterations=2)
