@@ -601,7 +601,8 @@ def markdown_notebook(source, targets):
 # the site's navigation bars on pdoc's page (the notebooks' pages style them in TEMPLATE)
 REFERENCE_NAV_CSS = """nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
   font-family: system-ui, sans-serif; font-size: 14px; border-bottom: 1px solid #ddd; }
-nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }"""
+nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
+nav.site-nav { position: static; height: auto; width: auto; overflow: visible; }  /* pdoc fixes every nav */"""
 
 
 def reference_html(nav):
@@ -618,10 +619,12 @@ def reference_html(nav):
     page = pdoc.render.html_module(module, all_modules={"geomlib": module})
     page = re.sub(r"<title>[^<]*</title>", f"<title>{html.escape(REFERENCE_TITLE)}</title>", page, count=1)
     style = f"<style>{REFERENCE_NAV_CSS}</style>"
+    # inside pdoc's main column: its module list is a fixed column on the left of a wide window
+    bottom = nav.replace('class="site-nav"', 'class="site-nav bottom"')
     return (
         page.replace("</head>", style + "\n</head>", 1)
-        .replace("<body>", "<body>\n" + nav, 1)
-        .replace("</body>", nav.replace('class="site-nav"', 'class="site-nav bottom"') + "\n</body>", 1)
+        .replace('<main class="pdoc">', '<main class="pdoc">\n' + nav, 1)
+        .replace("</main>", bottom + "\n</main>", 1)
     )
 
 
@@ -753,7 +756,7 @@ def build(out=OUT, names=None, log=print):
         if states:  # JSON inside <script>: "</" written as "<\/" so no text in it ends the element
             resources["site_states"] = json.dumps(states, separators=(",", ":")).replace("</", "<\\/")
         body, _ = page_exporter.from_notebook_node(nb, resources=resources)
-        (out / page["file"]).write_text(body, encoding="utf-8")
+        (out / page["file"]).write_text(share_styles(body, out), encoding="utf-8")
         page["bytes"] = (out / page["file"]).stat().st_size
     items = "\n".join(
         f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
@@ -773,6 +776,33 @@ def build(out=OUT, names=None, log=print):
     )
     (out / "pages.json").write_text(json.dumps(pages, indent=1))
     return pages
+
+
+SHARED_STYLE = 8192  # bytes: a style sheet of the page's head this large goes to a file of its own
+
+
+def share_styles(page, site):
+    """``page`` (HTML text) with each large style sheet of its head moved to a file in
+    ``site/assets/site/`` named by its hash, the ``<style>`` element replaced by a
+    ``<link>`` to it in the same place. nbconvert writes JupyterLab's theme (about
+    260 KB) into every page; shared, a browser reads it once, and the site is that much
+    smaller per page. Sheets that refer to other files (``url()`` or ``@import`` other than
+    ``data:``) stay in the page, where their relative addresses hold."""
+    end = page.find("</head>")
+
+    def move(m):
+        css = m.group(1)
+        if len(css) < SHARED_STYLE or re.search(r"@import|url\(\s*['\"]?(?!data:)", css):
+            return m.group(0)
+        name = f"{ASSETS}/site/style-{hashlib.sha256(css.encode()).hexdigest()[:12]}.css"
+        path = Path(site) / name
+        if not path.exists():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(css, encoding="utf-8")
+        return f'<link rel="stylesheet" href="{name}">'
+
+    head = re.sub(r'<style type="text/css">(.*?)</style>', move, page[:end], flags=re.S)
+    return head + page[end:]
 
 
 def live_sliders_text(n):
