@@ -250,6 +250,8 @@ def test_the_reference_page_lists_the_public_names_with_the_sites_navigation():
     assert all(f'id="{name}"' in page for name in geomlib.__all__)
     assert page.count('class="site-nav"') == 1 and page.count('class="site-nav bottom"') == 1
     assert 'href="developing.html"' in page and "<title>geomlib reference" in page
+    assert '<a class="headerlink" href="#load_mesh" aria-label="link to load_mesh"></a>' in page
+    assert all("aria-label=" in a for a in re.findall(r"<a [^>]*>\s*</a>", page))  # every empty link named
     assert not re.search(r"""(?:src=|href=)["'](?:https?:)?//[^"']+\.(?:js|css)""", page)
 
 

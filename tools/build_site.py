@@ -598,11 +598,18 @@ def markdown_notebook(source, targets):
     return nb
 
 
+# a documentation page is mostly links in running text: underlined, so that they are told
+# apart from the text by more than their colour (WCAG 1.4.1)
+DOC_CSS = ".jp-RenderedMarkdown a { text-decoration: underline; }"
+
 # the site's navigation bars on pdoc's page (the notebooks' pages style them in TEMPLATE)
 REFERENCE_NAV_CSS = """nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
   font-family: system-ui, sans-serif; font-size: 14px; border-bottom: 1px solid #ddd; }
 nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
-nav.site-nav { position: static; height: auto; width: auto; overflow: visible; }  /* pdoc fixes every nav */"""
+nav.site-nav { position: static; height: auto; width: auto; overflow: visible; }  /* pdoc fixes every nav */
+/* pdoc's greens on its grey signature boxes reach 4.0-4.4:1; this green, 6.4:1 (WCAG AA asks 4.5) */
+.pdoc { --def: #006400; }
+.pdoc .kc, .pdoc .bp, .pdoc .nb, .pdoc .k, .pdoc .kn, .pdoc .ow { color: #006400; }"""
 
 
 def reference_html(nav):
@@ -618,6 +625,12 @@ def reference_html(nav):
     module = pdoc.doc.Module(geomlib)
     page = pdoc.render.html_module(module, all_modules={"geomlib": module})
     page = re.sub(r"<title>[^<]*</title>", f"<title>{html.escape(REFERENCE_TITLE)}</title>", page, count=1)
+    # pdoc's anchor beside each entry is an empty link: it gets a name a screen reader can say
+    page = re.sub(
+        r'<a class="headerlink" href="#([^"]+)"></a>',
+        lambda m: f'<a class="headerlink" href="#{m[1]}" aria-label="link to {m[1]}"></a>',
+        page,
+    )
     style = f"<style>{REFERENCE_NAV_CSS}</style>"
     # inside pdoc's main column: its module list is a fixed column on the left of a wide window
     bottom = nav.replace('class="site-nav"', 'class="site-nav bottom"')
@@ -707,9 +720,13 @@ def build(out=OUT, names=None, log=print):
         log(f"executing {path.name} ...")
         nb, recorded = execute(path)
         live = prepare_for_site(nb, recorded)
+        source = f"notebooks/{path.name}"
         for cell in nb.cells:
             if cell.cell_type == "markdown":
-                cell.source = site_links(cell.source, f"notebooks/{path.name}", targets)
+                cell.source = site_links(cell.source, source, targets)
+            for output in cell.get("outputs", []):  # text a cell shows as markdown (explain, notes)
+                if "text/markdown" in output.get("data", {}):
+                    output["data"]["text/markdown"] = site_links(output["data"]["text/markdown"], source, targets)
         sliders = [s for r in recorded.values() for s in r.get("sliders", [])]
         pages.append(
             {
@@ -756,6 +773,8 @@ def build(out=OUT, names=None, log=print):
         if states:  # JSON inside <script>: "</" written as "<\/" so no text in it ends the element
             resources["site_states"] = json.dumps(states, separators=(",", ":")).replace("</", "<\\/")
         body, _ = page_exporter.from_notebook_node(nb, resources=resources)
+        if page["kind"] == "doc":
+            body = body.replace("</head>", f"<style>{DOC_CSS}</style>\n</head>", 1)
         (out / page["file"]).write_text(share_styles(body, out), encoding="utf-8")
         page["bytes"] = (out / page["file"]).stat().st_size
     items = "\n".join(
