@@ -15,8 +15,8 @@ eigenvectors are the normalised indicator functions of the components
 
 How it is solved (:func:`eigenbasis`, which solves on every call, builds
 ``(M, C)`` and hands them to :func:`eigenpairs`, the solve for a given pair): ``M^-1 C``
-is not symmetric, so with ``D = M^1/2`` the problem becomes ``Q y = lam y``,
-``Q = -D^-1 C D^-1``, ``e = D^-1 y`` (Vallet and Levy 2008), handed to
+is not symmetric, so with ``D = M^1/2`` the problem becomes ``Q z = lam z``,
+``Q = -D^-1 C D^-1``, ``e = D^-1 z`` (Vallet and Levy 2008), handed to
 :func:`geomlib.numerics.eigen.smallest_eigenpairs` (dense LAPACK for small
 meshes, block Lanczos on one sparse Cholesky factorisation otherwise).
 
@@ -59,8 +59,8 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
     """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
 
     ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
-    Solved in the symmetric form ``Q y = lam y`` with ``Q = -M^-1/2 C M^-1/2``
-    and ``e = M^-1/2 y`` (Vallet and Levy 2008): dense LAPACK for small meshes,
+    Solved in the symmetric form ``Q z = lam z`` with ``Q = -M^-1/2 C M^-1/2``
+    and ``e = M^-1/2 z`` (Vallet and Levy 2008): dense LAPACK for small meshes,
     block Lanczos on the inverse of ``Q + shift I``, applied by one sparse
     Cholesky factorisation, otherwise (:mod:`geomlib.numerics.eigen`); the
     solve for the pair is :func:`eigenpairs`. Every call solves;
@@ -78,7 +78,7 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
         when k is more than a third of n, "sparse" otherwise; "arpack" is
         another name for "sparse" (kept for old calls).
     tol : float
-        Relative residual of the sparse solve, ``||Q y - lam y|| <= tol ||Q||``
+        Relative residual of the sparse solve, ``||Q z - lam z|| <= tol ||Q||``
         (:func:`geomlib.numerics.eigen.smallest_eigenpairs`).
 
     Returns
@@ -125,7 +125,7 @@ def eigenpairs(M, C, k, *, method="auto", tol=1e-10):
     The solve behind :func:`eigenbasis`, for any pair with the signs of
     :func:`geomlib.laplacian`: ``C`` (n, n) symmetric negative semidefinite
     with rows summing to zero, ``M`` (n, n) diagonal and positive. Solved in the
-    symmetric form ``Q y = lam y``, ``Q = -M^-1/2 C M^-1/2``, ``e = M^-1/2 y``
+    symmetric form ``Q z = lam z``, ``Q = -M^-1/2 C M^-1/2``, ``e = M^-1/2 z``
     (Vallet and Levy 2008). The null space is known before the solve: on each
     connected piece of the graph of C (the mesh's components), the constant.
 
@@ -150,12 +150,12 @@ def eigenpairs(M, C, k, *, method="auto", tol=1e-10):
     m = positive_vertex_areas(M, None, "eigenpairs")
     k, method = _check_k(k, len(m)), _check_method(method)
     D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
-    Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q y = lam y (notebook 04's symbol)
+    Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q z = lam z (notebook 04's symbol)
     shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
     count, labels = _components(C, m)
-    Y0 = null_vectors(labels, count, m)  # Q (sqrt(A_i) on one component, 0 elsewhere) = 0: known, kept out of the solve
-    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol, null=Y0)
-    E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
+    Z0 = null_vectors(labels, count, m)  # Q (sqrt(A_i) on one component, 0 elsewhere) = 0: known, kept out of the solve
+    lam, Z = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol, null=Z0)
+    E = D_inv @ Z  # e = M^-1/2 z, so E^T M E = Z^T Z = I
     return _tidy(lam, E, m, count, labels)
 
 
@@ -208,15 +208,15 @@ def null_vectors(labels, count, m):
     area, largest first, as :func:`eigenbasis` orders them) and 0 elsewhere,
     normalised: ``Q`` maps it to 0 because every row of C sums to 0.
     """
-    Y0 = (labels[:, None] == np.arange(count)[None, :]) * np.sqrt(m)[:, None]
-    return Y0 / np.linalg.norm(Y0, axis=0)
+    Z0 = (labels[:, None] == np.arange(count)[None, :]) * np.sqrt(m)[:, None]
+    return Z0 / np.linalg.norm(Z0, axis=0)
 
 
 def _tidy(lam, E, m, count, labels):
     """Exact zeros and indicator functions for the null space, M-normalised columns, fixed signs."""
     lam = np.array(lam, dtype=np.float64)
     E = np.asfortranarray(E)
-    E /= np.sqrt(np.einsum("ij,i,ij->j", E, m, E))[None, :]  # Y^T Y = I only to rounding
+    E /= np.sqrt(np.einsum("ij,i,ij->j", E, m, E))[None, :]  # Z^T Z = I only to rounding
     if count > 1:
         warnings.warn(
             f"the mesh has {count} connected components: the first {count} eigenvalues are 0 "
