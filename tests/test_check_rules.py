@@ -27,6 +27,7 @@ SHORTCUTS = {
     "explicit_step": smoothing.explicit_step,
     "explicit_step_limit": geomlib.explicit_step_limit,
     "implicit_step": smoothing.implicit_step,
+    "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
     "vertex_rms": geomlib.vertex_rms,
     "normal_curvature": lambda a, b, c, phi: symbolic.ellipsoid_normal_curvature(a, b, c, phi),
