@@ -181,6 +181,9 @@ body.jp-Notebook {
 .widget-slider .noUi-handle { border-color: #6b6b6b !important; }
 .widget-inline-hbox .widget-label { width: auto; min-width: var(--jp-widgets-inline-label-width);
   overflow: visible; text-overflow: clip; }
+/* links in running text are told apart by more than their colour (WCAG 1.4.1) */
+body.jp-Notebook .jp-RenderedHTMLCommon a, body.jp-Notebook .jp-RenderedHTMLCommon a:link,
+body.jp-Notebook .jp-RenderedHTMLCommon a:visited { text-decoration: underline; }
 .geomlib-canvas:focus { outline: 3px solid #1a5fb4; outline-offset: 2px; }
 p.site-view-keys { font-size: 13px; color: #444; margin: 0.2em 0; }
 .site-visually-hidden { position: absolute; width: 1px; height: 1px; overflow: hidden; clip: rect(0 0 0 0);
@@ -430,9 +433,7 @@ def prepare_for_site(nb, recorded=None):
                 continue
             renderers = sum(state[m].get("model_name") == "RendererModel" for m in models)
             live += renderers
-            if renderers:
-                outputs.append(_html_output(f'<p class="site-view-keys">{html.escape(VIEW_KEYS)}</p>'))
-            if renderers and "image/png" in output["data"]:
+            if renderers and "image/png" in output["data"]:  # right after its view (the reveal script)
                 alt = output.get("metadata", {}).get("image/png", {}).get("alt") or "still picture of the 3D view"
                 outputs.append(
                     _html_output(
@@ -440,6 +441,8 @@ def prepare_for_site(nb, recorded=None):
                         f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'
                     )
                 )
+            if renderers:
+                outputs.append(_html_output(f'<p class="site-view-keys">{html.escape(VIEW_KEYS)}</p>'))
             snapping = [s for s in live_sliders.values() if s["model_id"] in models]
             if snapping:
                 outputs.append(_html_output(f'<p class="site-snap-note">{html.escape(snap_note(snapping))}</p>'))
@@ -722,6 +725,7 @@ def reference_html(nav):
     top = nav.replace('<nav class="site-nav"', '<nav class="site-nav" aria-label="Pages"')
     bottom = nav.replace('<nav class="site-nav"', '<nav class="site-nav bottom" aria-label="Pages (end of page)"')
     page = re.sub(r"(<body[^>]*>)", lambda m: m[1] + "\n" + SKIP_LINK, page, count=1)
+    page = page.replace('<nav class="pdoc">', '<nav class="pdoc" aria-label="Contents of the reference">', 1)
     return (
         page.replace("</head>", style + "\n</head>", 1)
         .replace('<main class="pdoc">', '<main class="pdoc" id="site-content" tabindex="-1">\n' + top, 1)

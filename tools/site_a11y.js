@@ -17,7 +17,6 @@
 //   (#site-live): the slider's value, the cell's read-out lines and its colour-bar ranges.
 (function () {
   "use strict";
-  var KEYS_ID = "site-view-keys";
   var uid = 0;
 
   function id(el, prefix) {
@@ -96,8 +95,12 @@
     var described = [];
     var caption = captionOf(box);
     if (caption) described.push(id(caption, "site-alt"));
-    if (document.getElementById(KEYS_ID)) described.push(KEYS_ID);
+    var cell = box.closest(".jp-Cell") || document;
+    var keys = cell.querySelector("p.site-view-keys");
+    if (keys) described.push(id(keys, "site-keys"));
     set(box, "aria-describedby", described.join(" ") || null);
+    // the picture pythreejs freezes a view into stands in for the canvas: the box names it
+    box.querySelectorAll("img").forEach(function (img) { set(img, "alt", ""); });
     if (!box.dataset.siteKeys) {
       box.dataset.siteKeys = "1";
       box.addEventListener("keydown", onViewKey, true);
