@@ -4,7 +4,7 @@ import matplotlib
 import numpy as np
 import pytest
 
-from geomlib.teaching.section_diagram import normal_section, normal_section_figure
+from geomlib.teaching.normal_curvature_plots import normal_section, normal_section_figure
 
 matplotlib.use("Agg")
 

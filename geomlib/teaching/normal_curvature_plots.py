@@ -1,6 +1,6 @@
-"""The diagram of notebook 02: a normal section of the ellipsoid, drawn from the ellipsoid's own geometry.
+"""The pictures of notebook 02: a normal section of the ellipsoid, and kappa_n(phi) plotted three ways.
 
-At a point p(u, v) of ``ellipsoid(a, b, c)``: the tangent plane with the coordinate tangents
+``normal_section_figure`` is the diagram of the derivation. At a point p(u, v) of ``ellipsoid(a, b, c)``: the tangent plane with the coordinate tangents
 p_u and p_v, the unit tangent t(phi) at angle phi from p_u (towards p_v, as in
 ``geomlib.lessons.symbolic``), the outward unit normal n, and the plane through n and t,
 which cuts the surface in a plane curve, the normal section, whose curvature at the point is
@@ -12,7 +12,7 @@ import numpy as np
 
 from ..lessons.symbolic import ellipsoid
 
-__all__ = ["normal_section", "normal_section_figure"]
+__all__ = ["normal_section", "normal_section_figure", "polar_and_dupin_figure", "kappa_turn_figure"]
 
 
 def normal_section(a, b, c, phi, u=0.0, v=np.pi / 2, samples=241):
@@ -95,5 +95,92 @@ def normal_section_figure(a, b, c, phi, u=0.0, v=np.pi / 2):
         f"tangent t at phi = {degrees:.0f} degrees from p_u; the arrow n is the outward normal. The plane of n and t "
         f"cuts the ellipsoid in the thick curve, the normal section; the dashed circle touching it at the point has "
         f"radius 1/kappa_n = {1 / k:.3f}, the curvature of the section there being kappa_n = {k:.3f} per length unit."
+    )
+    return fig, alt
+
+
+def polar_and_dupin_figure(phis, kappa, a, b, c):
+    """(fig, alt): kappa_n(phi) at (a, 0, 0) as a polar curve, and Dupin's indicatrix beside it.
+
+    ``kappa`` (values at the angles ``phis``, radians from p_u) is drawn as a radius in
+    direction phi (left) and as the radius 1/sqrt(|kappa_n|) (right, solid), over the ellipse
+    kappa_u xi^2 + kappa_v eta^2 = 1 of the exact principal curvatures kappa_u = a/b^2,
+    kappa_v = a/c^2 (dotted). The alt text reports the plotted extremes and where they are.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    phis, kappa = np.asarray(phis, dtype=float), np.asarray(kappa, dtype=float)
+    k_u, k_v = a / b**2, a / c**2
+    fig = plt.figure(figsize=(9, 4.3))
+    ax1 = fig.add_subplot(1, 2, 1, projection="polar")
+    ax1.plot(phis, kappa, color="black")
+    ax1.yaxis.set_major_locator(MaxNLocator(3))  # three radial labels, apart from each other
+    ax1.set_rlabel_position(112.5)
+    ax1.set_xticks(np.radians([0, 90, 180, 270]), [r"$0$ ($p_u$)", r"$\pi/2$ ($p_v$)", r"$\pi$", r"$3\pi/2$"])
+    ax1.set_title(r"$\kappa_n(\varphi)$ at $(a, 0, 0)$ (1/length)", fontsize=10, pad=14)
+    r = 1 / np.sqrt(np.abs(kappa))
+    ax2 = fig.add_subplot(1, 2, 2)
+    ax2.plot(r * np.cos(phis), r * np.sin(phis), color="0.6", linewidth=3, label=r"$1/\sqrt{|\kappa_n|}$")
+    ellipse = np.cos(phis) / np.sqrt(k_u), np.sin(phis) / np.sqrt(k_v)
+    ax2.plot(*ellipse, "k:", linewidth=1.5, label=r"$\kappa_u \xi^2 + \kappa_v \eta^2 = 1$")
+    ax2.set_aspect("equal")
+    ax2.set_xlabel(r"$\xi$, along $p_u$ (length$^{1/2}$)")
+    ax2.set_ylabel(r"$\eta$, along $p_v$")
+    ax2.set_title("Dupin's indicatrix", fontsize=10)
+    ax2.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, fontsize=9, frameon=False)
+    fig.tight_layout()
+    top, low = int(np.argmax(kappa)), int(np.argmin(kappa))
+    alt = (
+        f"Left, a polar plot of the normal curvature at (a, 0, 0) of the ellipsoid a = {a:g}, b = {b:g}, c = {c:g}: "
+        f"the radius is largest, {kappa[top]:.3f}, at phi = {np.degrees(phis[top]):.0f} degrees and smallest, "
+        f"{kappa[low]:.3f}, at phi = {np.degrees(phis[low]):.0f} degrees from p_u, repeating every 180 degrees. "
+        f"Right, Dupin's indicatrix: the radius 1/sqrt(kappa_n) traces an ellipse with semi-axes "
+        f"{1 / np.sqrt(k_u):.3f} along p_u and {1 / np.sqrt(k_v):.3f} along p_v, on top of the dotted ellipse "
+        f"drawn from the principal curvatures a/b^2 = {k_u:.3f} and a/c^2 = {k_v:.3f}."
+    )
+    return fig, alt
+
+
+def kappa_turn_figure(a, b, c, swapped=False):
+    """(fig, alt): kappa_n(phi) at (a, 0, 0) over a full turn, with a/b^2 and a/c^2 marked.
+
+    Values from ``ellipsoid_normal_curvature``; ``swapped`` adds the curve of the ellipsoid with b
+    and c exchanged (dash-dot). Lines are told apart by style and direct labels.
+    """
+    import matplotlib.pyplot as plt
+
+    from ..lessons.symbolic import ellipsoid_normal_curvature
+
+    phis = np.linspace(0, 2 * np.pi, 361)
+    kappa = ellipsoid_normal_curvature(a, b, c, phis)
+    fig, ax = plt.subplots(figsize=(7, 3.2))
+    ax.plot(phis, kappa, color="black", label=f"$a={a:g}$, $b={b:g}$, $c={c:g}$")
+    if swapped:
+        ax.plot(phis, ellipsoid_normal_curvature(a, c, b, phis), "-.", color="0.4", label="$b$ and $c$ swapped")
+    for value, style, text in ((a / b**2, "--", r"$a/b^2$ (along $p_u$)"), (a / c**2, ":", r"$a/c^2$ (along $p_v$)")):
+        ax.axhline(value, color="0.5", linestyle=style, linewidth=0.9)
+        ax.annotate(text, (2 * np.pi, value), xytext=(4, 0), textcoords="offset points", va="center", fontsize=9)
+    ax.set_xticks(np.pi * np.arange(0, 2.01, 0.5), ["0", r"$\pi/2$", r"$\pi$", r"$3\pi/2$", r"$2\pi$"])
+    ax.set_xlabel(r"$\varphi$ (rad, from $p_u$ towards $p_v$)")
+    ax.set_ylabel(r"$\kappa_n$ (1/length)")
+    ax.set_ylim(0, 1.3 * max(a / b**2, a / c**2))
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=2, frameon=False)
+    ax.set_title(r"normal curvature at $(a, 0, 0)$", fontsize=10)
+    spread = float(kappa.max() - kappa.min())
+    shape = (
+        "a flat line: every direction is principal (an umbilic)"
+        if spread < 1e-9 * kappa.max()
+        else f"a wave of period pi between {kappa.min():.3f} and {kappa.max():.3f}, touching a/b^2 at phi = 0 and "
+        "a/c^2 at phi = pi/2"
+    )
+    alt = (
+        f"Line plot of the normal curvature at (a, 0, 0) against phi from 0 to 2 pi for a = {a:g}, b = {b:g}, "
+        f"c = {c:g}, with dashed and dotted lines at a/b^2 = {a / b**2:.3f} and a/c^2 = {a / c**2:.3f}: {shape}."
+        + (
+            " The dash-dot curve of the ellipsoid with b and c swapped is the same wave shifted by pi/2."
+            if swapped
+            else ""
+        )
     )
     return fig, alt
