@@ -38,6 +38,6 @@ def test_boundary_vertex_is_refused_and_alt_text_says_the_numbers():
         unfolded_fan(s.V, s.F, 0)
     ico, T = surfaces.sphere(1.0, subdivisions=0), surfaces.torus(1.0, 0.35, n=8)
     inner = int(np.argmin(np.hypot(T.V[:, 0], T.V[:, 1])))
-    fig, alt = angle_fan_figure([("icosahedron", ico.V, ico.F, 0), ("torus", T.V, T.F, inner)])
+    fig, alt, deficits = angle_fan_figure([("icosahedron", ico.V, ico.F, 0), ("torus", T.V, T.F, inner)])
     assert "sum to 300.0°, leaving a gap of 60.0°" in alt and "overlapping by" in alt and "K < 0" in alt
-    assert len(fig.axes) == 2
+    assert len(fig.axes) == 2 and deficits[0] > 0 > deficits[1]

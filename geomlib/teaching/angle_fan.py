@@ -102,15 +102,16 @@ def angle_fan_figure(fans):
 
     Returns
     -------
-    fig : matplotlib Figure, alt : str
+    fig : matplotlib Figure, alt : str, deficits : list of float (radians, one per fan)
     """
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, len(fans), figsize=(4.6 * len(fans), 4.4), squeeze=False)
-    said = []
+    said, deficits = [], []
     for ax, (title, V, F, i) in zip(axes[0], fans):
         points, theta, deficit = unfolded_fan(V, F, i)
         _draw(ax, points, theta, deficit, title)
+        deficits.append(deficit)
         kind = (
             f"leaving a gap of {np.degrees(deficit):.1f}°, a positive deficit (K > 0)"
             if deficit > 0
@@ -123,4 +124,4 @@ def angle_fan_figure(fans):
     alt = "The triangles around a mesh vertex, unfolded flat with their true edge lengths and angles. " + "; ".join(
         said
     )
-    return fig, alt + "."
+    return fig, alt + ".", deficits
