@@ -118,12 +118,14 @@ def test_live_runs_the_update_now_and_after_every_move(meshes):
     s.value = 0.8
     assert calls[-1] == (0.8, 2) and len(knobs.timings) == 2
     np.testing.assert_allclose(view.V, 1.8 * V)
-    text = knobs._repr_mimebundle_()["text/plain"]
+    bundle, metadata = knobs._repr_mimebundle_()
+    text = bundle["text/plain"]
     assert text.startswith("scale 0.8\ncount 2\n⚠ the run diverged at iteration 3 (") and text.endswith(" ms)")
     # controls, read-out and view in one box: the browser tests move the slider next to a view
     box = knobs.widget
     assert s in box.children[0].children and view.widget in box.children
-    assert "image/png" in knobs._repr_mimebundle_()
+    assert "image/png" in bundle
+    assert metadata == {"image/png": {"alt": view.alt_text()}}  # the still's alt is the view's text
 
 
 def test_mesh_warnings_collects_the_messages():

@@ -1,13 +1,16 @@
 """A course grades the workbook's exercises with nbgrader (the version pinned in the dev extra).
 
 notebooks/ is the course's source version as it stands. A course folder in a
-temporary directory releases notebooks 01 and 05 (``generate_assignment``);
-three students hand them in: the stubs as released, every solution, and every
-solution but one with a typical mistake (the sign of C flipped in the uniform
-Laplacian). One ``autograde`` grades them all; ``export`` writes the CSV;
-``validate`` fails on the stubs, naming the exercises, and passes on a full
-solution; ``generate_feedback`` writes pages whose 3D views are pictures and
-whose failed grade cell shows the check's diagnosis.
+temporary directory releases every exercise notebook (``generate_assignment``);
+no released cell shows the source of a routine an exercise asks for. Three
+students hand in the graded notebooks: the stubs as released, every solution, and
+every solution but one with a typical mistake (the sign of C flipped in the
+uniform Laplacian). One ``autograde`` grades them all: the auto-graded points
+are scored, the hand-graded discussion waits as "needs manual grade" until a
+grader enters points; ``export`` writes the CSV; ``validate`` fails on the stubs,
+naming the exercises, and passes on a full solution; ``generate_feedback`` writes
+pages whose 3D views are pictures and whose failed grade cell shows the check's
+diagnosis.
 """
 
 import csv
@@ -23,31 +26,32 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
+sys.path.insert(0, str(ROOT / "tests"))
 
 import build_assignment  # noqa: E402
+from test_assignment import answer_leaks, exercises_of  # noqa: E402
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
+EXERCISE_NOTEBOOKS = [p for p in NOTEBOOKS if p.name[:2] != "00" and p.name[2] == "_"]
 BIN = Path(sys.executable).parent
 ASSIGNMENT = "curvature"
+# the notebooks the three students hand in: the first task and the smoothing tasks
 GRADED = {"01": "01_uniform_laplace_curvature", "05": "05_explicit_smoothing"}
 WRONG_EXERCISE = "uniform_laplacian"
 DIAGNOSIS = "the sign of C is flipped"
-# (notebook 01, notebook 05) scores of each student, out of (6, 4): the README's table
-SCORES = {"stubs": (0.0, 0.0), "solved": (6.0, 4.0), "one_mistake": (4.0, 4.0)}
-MAX_SCORES = (6.0, 4.0)
+GRADING = ROOT / "docs" / "grading.md"
 
 
-def readme_points():
-    """{(notebook, exercise): (check points, partial-credit points, total)} from the README's table."""
-    rows = re.findall(
-        r"^\| (\d\d) \| `(\w+)` \| (\d+) \| (\d+) \| (\d+) \|$", (ROOT / "README.md").read_text(), flags=re.M
-    )
-    return {(nb, ex): (int(a), int(b), int(t)) for nb, ex, a, b, t in rows}
+def guide_points():
+    """{(notebook, exercise): (check, partial credit, by hand, total)} from the grading guide's table."""
+    rows = re.findall(r"^\| (\d\d) \| `(\w+)` \| (\d*) \| (\d*) \| (\d*) \| (\d+) \|$", GRADING.read_text(), flags=re.M)
+    return {(nb, ex): tuple(int(x or 0) for x in values) for nb, ex, *values in rows}
 
 
 def notebook_points():
+    """The same table from the notebooks' grade cells: exercises and hand-graded answers."""
     points = {}
-    for path in NOTEBOOKS:
+    for path in EXERCISE_NOTEBOOKS:
         nb = nbformat.read(path, as_version=4)
         grade = {
             c.metadata["nbgrader"]["grade_id"]: c.metadata["nbgrader"]["points"]
@@ -56,18 +60,31 @@ def notebook_points():
         }
         for exercise, total in build_assignment.exercise_points(nb).items():
             parts = (grade[f"{exercise}_check"], grade[f"{exercise}_partial_credit"])
-            points[(path.name[:2], exercise)] = (*parts, total)
+            points[(path.name[:2], exercise)] = (*parts, 0, total)
+        for answer, hand in build_assignment.discussion_points(nb).items():
+            points[(path.name[:2], answer)] = (0, 0, hand, hand)
     return points
 
 
-def test_every_exercise_has_points_and_the_readme_lists_them():
+def auto_points(name):
+    """Auto-graded points of a notebook."""
+    return sum(a + b for (nb, _), (a, b, _, _) in notebook_points().items() if nb == name[:2])
+
+
+def hand_points(name):
+    return sum(h for (nb, _), (_, _, h, _) in notebook_points().items() if nb == name[:2])
+
+
+def test_every_exercise_and_discussion_has_points_and_the_guide_lists_them():
     points = notebook_points()
     assert {nb for nb, _ in points} == {f"0{i}" for i in range(1, 8)}
-    assert all(check >= 1 and partial == 1 for check, partial, _ in points.values())
-    assert readme_points() == points
-    total = sum(t for _, _, t in points.values())
-    assert f"| | **total** | | | **{total}** |" in (ROOT / "README.md").read_text()
-    assert tuple(sum(t for (nb, _), (_, _, t) in points.items() if nb == k) for k in GRADED) == MAX_SCORES
+    exercises = {k: v for k, v in points.items() if v[2] == 0}
+    discussions = {k: v for k, v in points.items() if v[2] > 0}
+    assert all(check >= 1 and partial == 1 for check, partial, _, _ in exercises.values())
+    assert {nb for nb, _ in discussions} == {f"0{i}" for i in range(1, 8)}, "a notebook without a graded discussion"
+    assert guide_points() == points
+    total = sum(t for *_, t in points.values())
+    assert f"| | **total** | | | | **{total}** |" in GRADING.read_text()
 
 
 def nbgrader(course, *args, check=True):
@@ -122,8 +139,8 @@ def course(tmp_path_factory):
     (course / "exchange").mkdir()
     source = course / "source" / ASSIGNMENT
     source.mkdir(parents=True)
-    for name in GRADED.values():
-        (source / f"{name}.ipynb").write_bytes((ROOT / "notebooks" / f"{name}.ipynb").read_bytes())
+    for path in EXERCISE_NOTEBOOKS:
+        (source / path.name).write_bytes(path.read_bytes())
     nbgrader(course, "generate_assignment", ASSIGNMENT)
     hand_in(course, "stubs")
     hand_in(course, "solved", lambda exercise, source: source)
@@ -135,19 +152,53 @@ def course(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_autograde_scores_stubs_zero_a_typical_mistake_fewer_and_solutions_full(course):
+@pytest.mark.parametrize("path", EXERCISE_NOTEBOOKS, ids=[p.name for p in EXERCISE_NOTEBOOKS])
+def test_nbgraders_release_shows_no_exercise_routine_and_no_model_answer(course, path):
+    nb = nbformat.read(course / "release" / ASSIGNMENT / path.name, as_version=4)
+    assert answer_leaks(nb, exercises_of(nb)) == []
+    assert not any(build_assignment.HIDDEN_BEGIN in c.source for c in nb.cells)
+    solution = nbformat.read(path, as_version=4)
+    for i, cell in build_assignment.answer_cells(solution):
+        assert nb.cells[i].source.strip() == "YOUR ANSWER HERE"
+
+
+@pytest.mark.slow
+def test_autograde_scores_stubs_zero_a_typical_mistake_fewer_solutions_full_and_waits_for_the_discussion(course):
     from nbgrader.api import Gradebook
 
+    auto = [auto_points(name) for name in GRADED.values()]
+    hand = [hand_points(name) for name in GRADED.values()]
+    wrong = notebook_points()[("01", WRONG_EXERCISE)][0]  # the check cell's points; partial credit stays
+    scores = {"stubs": [0.0] * len(auto), "solved": auto, "one_mistake": [auto[0] - wrong, *auto[1:]]}
     with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
-        for student, expected in SCORES.items():
+        for student, expected in scores.items():
             got = [gb.find_submission_notebook(name, ASSIGNMENT, student) for name in GRADED.values()]
-            assert tuple(nb.score for nb in got) == expected, student
-            assert tuple(nb.max_score for nb in got) == MAX_SCORES
+            assert [nb.score for nb in got] == expected, student
+            assert [nb.max_score for nb in got] == [a + h for a, h in zip(auto, hand)]
+            assert all(nb.needs_manual_grade for nb in got), "the discussion should wait for a grader"
+        # a grader enters the hand-graded points of the solved student: the score includes them
+        for name in GRADED.values():
+            submission = gb.find_submission_notebook(name, ASSIGNMENT, "solved")
+            for grade in submission.grades:
+                if grade.cell.max_score and grade.needs_manual_grade:
+                    grade.manual_score = grade.cell.max_score
+            gb.db.commit()
+        got = [gb.find_submission_notebook(name, ASSIGNMENT, "solved") for name in GRADED.values()]
+        assert [nb.score for nb in got] == [a + h for a, h in zip(auto, hand)]
+        assert not any(nb.needs_manual_grade for nb in got)
     with open(course / "grades.csv", newline="") as f:
         rows = {row["student_id"]: row for row in csv.DictReader(f)}
-    assert {s: (float(r["score"]), float(r["max_score"])) for s, r in rows.items()} == {
-        s: (sum(scores), sum(MAX_SCORES)) for s, scores in SCORES.items()
-    }
+    assert {s: float(r["score"]) for s, r in rows.items()} == {s: sum(v) for s, v in scores.items()}
+
+
+@pytest.mark.slow
+def test_grading_puts_the_model_answers_back(course):
+    for name in GRADED.values():
+        solution = nbformat.read(ROOT / "notebooks" / f"{name}.ipynb", as_version=4)
+        graded = nbformat.read(course / "autograded" / "solved" / ASSIGNMENT / f"{name}.ipynb", as_version=4)
+        hidden = [i for i, c in enumerate(solution.cells) if build_assignment.HIDDEN_BEGIN in c.source]
+        for i in hidden:
+            assert graded.cells[i].source == solution.cells[i].source
 
 
 def view_outputs(nb):
@@ -160,7 +211,7 @@ def view_outputs(nb):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("student", SCORES)
+@pytest.mark.parametrize("student", ("stubs", "solved", "one_mistake"))
 def test_feedback_pages_show_a_picture_for_every_view_and_the_diagnosis(course, student):
     for name in GRADED.values():
         nb = json.loads((course / "autograded" / student / ASSIGNMENT / f"{name}.ipynb").read_text())
@@ -179,7 +230,7 @@ def test_feedback_pages_show_a_picture_for_every_view_and_the_diagnosis(course, 
 @pytest.mark.slow
 def test_validate_names_the_exercises_still_to_do_and_passes_a_solution(course):
     stubs = nbgrader(course, "validate", str(course / "submitted" / "stubs" / ASSIGNMENT / f"{GRADED['01']}.ipynb"))
-    assert "VALIDATION FAILED ON 4 CELL(S)" in stubs.stdout
+    assert re.search(r"VALIDATION FAILED ON \d+ CELL\(S\)", stubs.stdout), stubs.stdout[-2000:]
     for exercise in ("uniform_laplacian", "gaussian_curvature"):
         assert f"CheckFailed: {exercise}: not written yet" in stubs.stdout
         assert f"CheckFailed: {exercise}, partial credit: not written yet" in stubs.stdout
@@ -192,9 +243,9 @@ def test_the_assignment_build_is_an_nbgrader_release_like_generate_assignments(c
     from nbgrader.nbgraderformat import MetadataValidator
 
     build_assignment.build(tmp_path)
-    for name in GRADED.values():
-        ours = nbformat.read(tmp_path / f"{name}.ipynb", as_version=4)
-        theirs = nbformat.read(course / "release" / ASSIGNMENT / f"{name}.ipynb", as_version=4)
+    for path in EXERCISE_NOTEBOOKS:
+        ours = nbformat.read(tmp_path / path.name, as_version=4)
+        theirs = nbformat.read(course / "release" / ASSIGNMENT / path.name, as_version=4)
         MetadataValidator().validate_nb(ours)
         keys = ("grade", "grade_id", "locked", "points", "solution")
         assert [{k: c.metadata.get("nbgrader", {}).get(k) for k in keys} for c in ours.cells] == [

@@ -18,7 +18,7 @@ from PIL import Image
 
 from geomlib import MeshError
 from geomlib.mesh.geometry import vertex_normals
-from geomlib.teaching.colours import NAN_COLOR, colorize, value_range
+from geomlib.teaching.colours import NAN_COLOR, NAN_NAME, colorize, value_range
 from geomlib.teaching.stills import render_still, view_normals
 from geomlib.teaching.viewer import MeshView, side_by_side, stills_only
 
@@ -199,7 +199,8 @@ def _decode(bundle):
 def test_mimebundle_has_widget_png_and_text(sphere):
     V, F = sphere
     view = MeshView(V, F, values=V[:, 2], symmetric=True, title="sphere", label="z")
-    bundle = view._repr_mimebundle_()
+    bundle, metadata = view._repr_mimebundle_()
+    assert metadata == {"image/png": {"alt": view.alt_text()}}
     assert set(bundle) >= {"application/vnd.jupyter.widget-view+json", "image/png", "text/plain"}
     assert bundle["application/vnd.jupyter.widget-view+json"]["model_id"] == view.widget.model_id
     image = _decode(bundle)
@@ -213,6 +214,61 @@ def test_mimebundle_has_widget_png_and_text(sphere):
     assert reds > 0.01 and blues > 0.01
     assert "642 vertices" in bundle["text/plain"] and "1280 faces" in bundle["text/plain"]
     assert not re.search(r"[0-9a-f]{32}", bundle["text/plain"])  # no model ids in text
+
+
+def test_alt_text_says_mesh_quantity_range_nans_and_what_to_look_for(sphere, messages):
+    V, F = sphere
+    H = V[:, 2].copy()
+    H[[3, 7]] = np.nan
+    view = MeshView(
+        V,
+        F,
+        values=H,
+        symmetric=True,
+        title="mean curvature",
+        label="H (1/length)",
+        description="The poles are extreme.",
+    )
+    lo, hi = view.range
+    assert view.alt_text() == (
+        f"3D view of mean curvature: a mesh of 642 vertices and 1280 faces, coloured by H (1/length) from "
+        f"{lo:.3g} to {hi:.3g} (RdBu_r colour map, 0 in the middle). 2 vertices have no value (NaN), drawn "
+        f"{NAN_NAME}. The poles are extreme."
+    )
+    # the text is in the page, under the canvas, and follows updates
+    assert view._caption in view.widget.children and "The poles are extreme." in view._caption.value
+    messages.clear()
+    view.update(values=5.0 * H, description="Five times as curved.")
+    assert "from -5 to 5" in view.alt_text() and view.alt_text().endswith("Five times as curved.")
+    assert "Five times as curved." in view._caption.value and "from -5 to 5" in view._caption.value
+    assert ("HTML", ["value"]) in messages
+    messages.clear()
+    view.update(values=5.0 * H)  # nothing new in the text: no message for it
+    assert all(name != "HTML" for name, _ in messages)
+    view.update(description="Only the words change.")
+    assert view.alt_text().endswith("Only the words change.") and "Only the words" in view._caption.value
+    # plain and zero views say so; no description, no trailing words
+    assert MeshView(V, F).alt_text() == "3D view: a mesh of 642 vertices and 1280 faces, plain shading (no colour map)."
+    zero = MeshView(V, F, values=np.zeros(len(V)), label="K")
+    assert "coloured by K: 0 everywhere" in zero.alt_text() and zero.alt_text().endswith("drawn white.")
+
+
+def test_the_still_of_a_box_of_views_carries_their_alt_text(sphere):
+    from IPython.core.formatters import DisplayFormatter
+
+    from geomlib.teaching import viewer
+    from geomlib.teaching.viewer import box_alt
+
+    V, F = sphere
+    a, b = MeshView(V, F, title="a", description="look at a"), MeshView(V, F, title="b")
+    box = ipywidgets.VBox([ipywidgets.FloatSlider(), ipywidgets.HBox([a.widget, b.widget])])
+    assert box_alt(box) == a.alt_text() + " " + b.alt_text()
+    formatter = DisplayFormatter()
+    formatter.formatters["image/png"].for_type(ipywidgets.Box, viewer._box_png)  # as in IPython
+    data, metadata = formatter.format(box)
+    assert "image/png" in data and metadata["image/png"]["alt"] == box_alt(box)
+    data, metadata = formatter.format(a)
+    assert metadata["image/png"]["alt"] == a.alt_text() and a.alt_text().endswith("look at a")
 
 
 def test_still_puts_the_mesh_in_the_middle():
@@ -286,7 +342,9 @@ def test_side_by_side_links_cameras(sphere):
     # the shared camera is framed on the largest mesh
     assert np.linalg.norm(a.camera.position) == pytest.approx(row._distance)
     assert row._distance > MeshView(V, F)._distance  # b is twice as large
-    bundle = row._repr_mimebundle_()
+    bundle, metadata = row._repr_mimebundle_()
+    assert metadata["image/png"]["alt"].startswith("View 1 of 3: 3D view of a: a mesh of 642 vertices")
+    assert "View 3 of 3: 3D view: a mesh of 642 vertices and 1280 faces, plain shading" in metadata["image/png"]["alt"]
     image = _decode(bundle)
     assert image.shape[1] == 3 * a.width + 2 * 8
     assert bundle["text/plain"].count("MeshView") == 3
@@ -301,7 +359,7 @@ def test_while_nbgrader_runs_a_view_is_its_still_without_the_widget(sphere, monk
     assert stills_only()
     view = MeshView(V, F, title="sphere")
     row = side_by_side(view, MeshView(V, F))
-    for bundle in (view._repr_mimebundle_(), row._repr_mimebundle_()):
+    for bundle, _ in (view._repr_mimebundle_(), row._repr_mimebundle_()):
         assert set(bundle) == {"image/png", "text/plain"}
         assert _decode(bundle).shape[1] >= view.width
 

@@ -20,6 +20,14 @@ solution cell (metadata ``nbgrader.grade = true``, ``locked``, ``points``):
 ``check.NAME.partial_credit(my_fn)`` (``NAME_partial_credit``). The build
 refuses a notebook whose exercise lacks either, so the output is an nbgrader
 release as it stands.
+The discussion is graded by hand: a markdown answer cell (``nbgrader.solution``
+and ``grade`` true, ``points``) holds the model answer in notebooks/ and becomes
+an empty answer box here, as nbgrader's ``generate_assignment`` makes it. A model
+answer built from the notebook's numbers sits in a locked grade cell of 0 points
+between ``### BEGIN HIDDEN TESTS`` and ``### END HIDDEN TESTS``: the region is
+removed here (and by nbgrader, which puts it back when it grades, so the student
+reads it in the feedback).
+
 The output folder holds the notebooks and a copy of nothing else: they import
 geomlib from the installed package and find the shipped meshes through it.
 """
@@ -34,6 +42,9 @@ import nbformat
 ROOT = Path(__file__).resolve().parent.parent
 BEGIN, END = "### BEGIN SOLUTION", "### END SOLUTION"
 _BLOCK = re.compile(r"^([ \t]*)### BEGIN SOLUTION[^\n]*\n.*?^[ \t]*### END SOLUTION[^\n]*(\n|$)", re.M | re.S)
+HIDDEN_BEGIN, HIDDEN_END = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
+_HIDDEN = re.compile(r"^[ \t]*### BEGIN HIDDEN TESTS[^\n]*\n.*?^[ \t]*### END HIDDEN TESTS[^\n]*(\n|$)", re.M | re.S)
+ANSWER_BOX = "*Your answer here: {points} point{s}, graded by hand.*"
 
 
 def stub_source(source, exercise, reread):
@@ -47,6 +58,44 @@ def stub_source(source, exercise, reread):
     if count == 0 or BEGIN in out or END in out:
         raise ValueError(f"exercise {exercise}: unbalanced or missing {BEGIN} / {END} markers")
     return out.rstrip("\n")
+
+
+def without_hidden_tests(source):
+    """``source`` with every hidden-tests region (markers included) removed."""
+    out = _HIDDEN.sub("", source)
+    if HIDDEN_BEGIN in out or HIDDEN_END in out:
+        raise ValueError(f"unbalanced {HIDDEN_BEGIN} / {HIDDEN_END} markers")
+    return out.rstrip("\n")
+
+
+def answer_cells(nb):
+    """The (index, cell) pairs of hand-graded markdown answer cells (nbgrader solution and grade)."""
+    return [
+        (i, c)
+        for i, c in enumerate(nb.cells)
+        if c.cell_type == "markdown"
+        and c.metadata.get("nbgrader", {}).get("solution")
+        and c.metadata.get("nbgrader", {}).get("grade")
+    ]
+
+
+def discussion_points(nb):
+    """{grade id: points} of the hand-graded answer cells of a notebook.
+
+    Raises ValueError for an answer cell without points, or a model-answer cell (a grade
+    cell whose source has a hidden-tests region) that carries points: model answers earn nothing.
+    """
+    points = {}
+    for _, cell in answer_cells(nb):
+        meta = cell.metadata["nbgrader"]
+        if not meta.get("points"):
+            raise ValueError(f"answer cell {meta.get('grade_id')!r} has no points")
+        points[meta["grade_id"]] = meta["points"]
+    for cell in nb.cells:
+        meta = cell.metadata.get("nbgrader", {})
+        if cell.cell_type == "code" and meta.get("grade") and HIDDEN_BEGIN in cell.source and meta.get("points"):
+            raise ValueError(f"model answer {meta.get('grade_id')!r} carries points; it must carry 0")
+    return points
 
 
 def solution_cells(nb):
@@ -102,6 +151,13 @@ def build(out):
             cell.source = stub_source(cell.source, exercise, checker.reread)
         try:
             exercise_points(nb)
+            for _, cell in answer_cells(nb):
+                points = cell.metadata["nbgrader"]["points"]
+                cell.source = ANSWER_BOX.format(points=points, s="" if points == 1 else "s")
+            discussion_points(nb)
+            for cell in nb.cells:
+                if cell.cell_type == "code" and cell.metadata.get("nbgrader", {}).get("grade"):
+                    cell.source = without_hidden_tests(cell.source)
         except ValueError as exc:
             raise SystemExit(f"{path.name}: {exc}") from None
         for cell in nb.cells:
@@ -111,6 +167,8 @@ def build(out):
                 and not cell.metadata.get("nbgrader", {}).get("solution")
             ):
                 raise SystemExit(f"{path.name}: solution markers in a cell without nbgrader solution metadata")
+            if HIDDEN_BEGIN in cell.source or HIDDEN_END in cell.source:
+                raise SystemExit(f"{path.name}: hidden-tests markers in a cell that is not a grade cell")
         nbformat.write(nb, out / path.name)
         written.append(path.name)
     return written

@@ -17,6 +17,7 @@ from ..mesh.errors import MeshError
 
 __all__ = [
     "NAN_COLOR",
+    "NAN_NAME",
     "ZERO_COLOR",
     "ZERO_TOL",
     "PLAIN_COLOR",
@@ -30,6 +31,8 @@ __all__ = [
 
 #: colour of vertices whose value is NaN (RGB in [0, 1])
 NAN_COLOR = (0.62, 0.62, 0.62)
+#: the name of NAN_COLOR, as the colour bar and the text alternatives say it
+NAN_NAME = "grey"
 #: colour of a field that is zero up to rounding (white: nothing to see)
 ZERO_COLOR = (1.0, 1.0, 1.0)
 #: default ``zero_tol``: a field whose finite values all satisfy |v| <= ZERO_TOL

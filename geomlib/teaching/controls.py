@@ -29,7 +29,7 @@ import warnings
 
 from ..mesh.errors import MeshError, MeshWarning
 from .stills import png_base64
-from .viewer import MeshView, ViewRow, box_still, stills_only
+from .viewer import MeshView, ViewRow, box_alt, box_still, stills_only
 
 __all__ = ["live", "Live", "mesh_warnings"]
 
@@ -88,11 +88,12 @@ class Live:
         # while nbgrader runs the notebook its feedback page is static HTML: the still and the read-out only
         bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         still = box_still(self.widget)
-        if still is not None:
-            bundle["image/png"] = png_base64(still)
         bundle["text/plain"] = html.unescape(self.readout.value.replace("<br>", "\n")).replace("<code>", "")
         bundle["text/plain"] = bundle["text/plain"].replace("</code>", "")
-        return bundle
+        if still is None:
+            return bundle
+        bundle["image/png"] = png_base64(still)
+        return bundle, {"image/png": {"alt": box_alt(self.widget)}}
 
 
 def live(update, controls, views, per_row=2):

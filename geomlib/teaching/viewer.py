@@ -83,6 +83,16 @@ Pictures that must not mislead
   :data:`SPECK_RATIO` times the largest is drawn enlarged to its size, with
   "drawn N x larger" under its title.
 
+Text alternative
+----------------
+``view.alt_text()`` says what the view shows: the mesh (vertices, faces,
+title), the quantity with its unit (``label``) and colour range, the NaN count
+and ``description`` (what to look for, given to ``MeshView`` and to
+``update``). It is in the page as a caption under the colour bar (class
+``geomlib-alt``), follows every ``update`` (one more small message, only when
+the text changed), and is the alt of the still: the display bundle is
+``(data, {"image/png": {"alt": alt_text()}})``.
+
 Without a front-end
 -------------------
 ``display(view)`` gives the widget together with a still picture (image/png,
@@ -112,6 +122,7 @@ from ..mesh.topology import Topology, edges
 from ..mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
 from .colours import (
     NAN_COLOR,
+    NAN_NAME,
     PLAIN_COLOR,
     ZERO_COLOR,
     ZERO_TOL,
@@ -137,7 +148,7 @@ from .stills import (
     view_normals,
 )
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "stills_only"]
+__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only"]
 
 #: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
 #: of the largest one is drawn enlarged to the largest one's size
@@ -288,6 +299,9 @@ class MeshView:
         A field whose finite values all lie within ``zero_tol`` of zero (in the
         values' units) is zero up to rounding: drawn in ``ZERO_COLOR`` (white),
         its colour bar saying so. 0 switches this off.
+    description : str or None
+        What to look for in the view, in a sentence ("the rim flattens first");
+        the end of its text alternative :meth:`alt_text`.
 
     Attributes
     ----------
@@ -319,6 +333,7 @@ class MeshView:
         up="z",
         frame=None,
         zero_tol=ZERO_TOL,
+        description=None,
     ):
         import ipywidgets as widgets
         import pythreejs as three
@@ -340,6 +355,7 @@ class MeshView:
         self._fixed = (vmin, vmax)
         self.width, self.height = int(width), int(height)
         self.title, self.label = title, label
+        self.description = None if description is None else str(description)
         self.up = check_choice("up", up, tuple(VIEWS))
         self._up, self._direction = VIEWS[up]
         self.zero_tol = float(zero_tol)
@@ -411,8 +427,13 @@ class MeshView:
         self._colorbar = widgets.HTML(
             self._colorbar_text(), layout=widgets.Layout(display=None if self._values is not None else "none")
         )
+        # the text alternative, in the page as a caption under the colour bar (the site ties it
+        # to the canvas with aria-describedby and announces its changes)
+        self._caption = widgets.HTML(self._caption_text(), layout=widgets.Layout(width=f"{self.width}px"))
+        self._caption.add_class("geomlib-alt")
         self.widget = widgets.VBox(
-            [self._title, self.renderer, self._colorbar], layout=widgets.Layout(width="auto", align_items="flex-start")
+            [self._title, self.renderer, self._colorbar, self._caption],
+            layout=widgets.Layout(width="auto", align_items="flex-start"),
         )
         self.widget.add_class("geomlib-view")
         _SHOWN[self.widget.model_id] = self
@@ -502,6 +523,7 @@ class MeshView:
                 obj.scale = (self._scale,) * 3
         self._title.value = self._title_text()
         self._title.layout.display = None if self._title.value else "none"
+        self._refresh_caption()
 
     def _colorbar_text(self):
         if self._values is None:
@@ -518,9 +540,42 @@ class MeshView:
             f"0 everywhere, up to rounding (largest |value| {format_value(largest)} <= {format_value(self.zero_tol)})"
         )
 
+    def alt_text(self):
+        """The view's text alternative: the mesh, the quantity with its unit and colour range, NaNs, the description.
+
+        Shown under the canvas, given to the still as its alt and to the canvas on the website.
+        """
+        what = f"3D view of {self.title}" if self.title else "3D view"
+        text = f"{what}: a mesh of {self._n} vertices and {self._F.shape[0]} faces"
+        if self._scale != 1.0:
+            text += f", drawn {self._scale:.3g} times larger"
+        name = self.label or "the values"
+        if self._values is None:
+            text += ", plain shading (no colour map)."
+        elif self.is_zero:
+            text += f", coloured by {name}: {self._zero_text()}, drawn white."
+        else:
+            lo, hi = self.range
+            text += f", coloured by {name} from {format_value(lo)} to {format_value(hi)} ({self.cmap} colour map"
+            text += ", 0 in the middle)." if self.symmetric else ")."
+        n_nan = 0 if self._values is None else int(np.isnan(self._values).sum())
+        if n_nan:
+            text += f" {n_nan} {'vertex has' if n_nan == 1 else 'vertices have'} no value (NaN), drawn {NAN_NAME}."
+        if self.description:
+            text += f" {self.description}"
+        return text
+
+    def _caption_text(self):
+        return f"<div class='geomlib-alt-text' style='font:12px sans-serif;color:#222'>{html.escape(self.alt_text())}</div>"
+
+    def _refresh_caption(self):
+        text = self._caption_text()
+        if text != self._caption.value:
+            self._caption.value = text
+
     # -- updates ---------------------------------------------------------------
 
-    def update(self, V=None, values=None, vmin=None, vmax=None):
+    def update(self, V=None, values=None, vmin=None, vmax=None, description=None):
         """Overwrite positions and/or colours in place: one message to the browser.
 
         Parameters
@@ -531,8 +586,11 @@ class MeshView:
             New per-vertex values (colours recomputed).
         vmin, vmax : float or None
             New fixed colour range (kept for later updates).
+        description : str or None
+            New sentence saying what to look for (the end of :meth:`alt_text`).
 
-        None leaves that part unchanged. The buffer objects stay the same; only
+        None leaves that part unchanged. The text alternative under the canvas is
+        sent again only when its text changed. The buffer objects stay the same; only
         their contents are replaced. Raises MeshError for wrong shapes.
         """
         new_V = V is not None
@@ -546,15 +604,17 @@ class MeshView:
             lo, hi = self._fixed
             self._fixed = (lo if vmin is None else float(vmin), hi if vmax is None else float(vmax))
             new_colors = new_colors or self._values is not None
-        if not (new_V or new_colors):
-            return
-        self._buffer.array = self._pack(V=new_V, colors=new_colors, old=self._buffer.array)
+        if description is not None:
+            self.description = str(description)
+        if new_V or new_colors:
+            self._buffer.array = self._pack(V=new_V, colors=new_colors, old=self._buffer.array)
         if new_colors:
             text = self._colorbar_text()
             if text != self._colorbar.value:
                 self._colorbar.value = text
             if self._colorbar.layout.display == "none":
                 self._colorbar.layout.display = None
+        self._refresh_caption()
 
     # -- display ---------------------------------------------------------------
 
@@ -605,7 +665,7 @@ class MeshView:
         bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         bundle["image/png"] = png_base64(self.still())
         bundle["text/plain"] = self.summary()
-        return bundle
+        return bundle, {"image/png": {"alt": self.alt_text()}}
 
     def __repr__(self):
         return f"<{self.summary()}>"
@@ -624,11 +684,15 @@ class ViewRow:
         """(h, w, 3) uint8: the still pictures of the views next to each other."""
         return in_a_row([v.still(distance=self._distance) for v in self.views])
 
+    def alt_text(self):
+        """The text alternatives of the views, left to right, in one text."""
+        return " ".join(f"View {k} of {len(self.views)}: {v.alt_text()}" for k, v in enumerate(self.views, 1))
+
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
         bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         bundle["image/png"] = png_base64(self.still())
         bundle["text/plain"] = "\n".join(v.summary() for v in self.views)
-        return bundle
+        return bundle, {"image/png": {"alt": self.alt_text()}}
 
     def __repr__(self):
         return "<ViewRow of " + "; ".join(v.summary() for v in self.views) + ">"
@@ -660,9 +724,25 @@ def box_still(box):
     return in_a_row(images) if images else None
 
 
+def box_alt(box):
+    """The text alternatives of the views inside an ipywidgets box, in one text ("" if it holds none)."""
+    texts = []
+
+    def collect(widget):
+        shown = _SHOWN.get(getattr(widget, "model_id", None))
+        if shown is not None:
+            texts.append(shown.alt_text())
+            return
+        for child in getattr(widget, "children", ()):
+            collect(child)
+
+    collect(box)
+    return " ".join(texts)
+
+
 def _box_png(box):
     image = box_still(box)
-    return None if image is None else png_base64(image)
+    return None if image is None else (png_base64(image), {"alt": box_alt(box)})
 
 
 def stills_only():
@@ -675,7 +755,10 @@ def _widget_stills_only(widget):
     image = box_still(widget)
     if image is None:  # a slider, a progress bar, an Output widget: its text, as without a front-end
         return {"text/plain": repr(widget)}
-    return {"image/png": png_base64(image), "text/plain": "still picture of the 3D views (live in Jupyter)"}
+    return (
+        {"image/png": png_base64(image), "text/plain": "still picture of the 3D views (live in Jupyter)"},
+        {"image/png": {"alt": box_alt(widget)}},
+    )
 
 
 def _give_boxes_stills():
