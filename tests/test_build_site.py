@@ -191,3 +191,81 @@ def test_the_states_are_on_the_page_and_cannot_end_their_script():
     assert f'<script src="{build_site.STATES_JS}">' in body
     (inside,) = re.findall(r'<script[^>]*id="site-states"[^>]*>(.*?)</script>', body, re.S)
     assert json.loads(inside) == states
+
+
+def test_links_become_the_sites_pages():
+    targets = {
+        "notebooks/05_explicit_smoothing.ipynb": "05_explicit_smoothing.html",
+        "docs/install.md": "install.html",
+        "README.md": "about.html",
+    }
+    text = (
+        "See [05](05_explicit_smoothing.ipynb#The-limit), [install](../docs/install.md), "
+        "[home](../README.md), ![a view](../docs/images/front.png), [the tool](../tools/build_site.py), "
+        "[`tools/run_notebook.py`](../tools/run_notebook.py), [web](https://example.org/x.md), [here](#top)\n"
+        "```bash\n[05](05_explicit_smoothing.ipynb)\n```"
+    )
+    assert build_site.site_links(text, "notebooks/04_spectral_reconstruction.ipynb", targets) == (
+        "See [05](05_explicit_smoothing.html#The-limit), [install](install.html), "
+        "[home](about.html), ![a view](images/front.png), the tool (`tools/build_site.py`), "
+        "`tools/run_notebook.py`, [web](https://example.org/x.md), [here](#top)\n"
+        "```bash\n[05](05_explicit_smoothing.ipynb)\n```"
+    )
+
+
+def test_reading_order_puts_each_appendix_after_its_core(tmp_path, monkeypatch):
+    for name in ("01a_dig_deeper_x.ipynb", "00_start.ipynb", "01_one.ipynb", "02_two.ipynb", "notes.ipynb"):
+        (tmp_path / name).write_text("{}")
+    monkeypatch.setattr(build_site, "NOTEBOOKS", tmp_path)
+    assert [p.name for p in build_site.notebook_paths()] == [
+        "00_start.ipynb",
+        "01_one.ipynb",
+        "01a_dig_deeper_x.ipynb",
+        "02_two.ipynb",
+    ]
+    pages = list(build_site.doc_pages())
+    assert pages[:3] == ["README.md", "docs/README.md", "docs/install.md"] and pages[-1] == "benchmarks/README.md"
+    assert {p.relative_to(build_site.ROOT).as_posix() for p in (build_site.ROOT / "docs").glob("*.md")} <= set(pages)
+
+
+def test_repeated_buffers_are_saved_once_and_name_their_first_copy():
+    big, other = "A" * 2000, "B" * 2000
+    state = {
+        "a": {"buffers": [{"path": ["array"], "encoding": "base64", "data": big}]},
+        "b": {"buffers": [{"path": ["x"], "encoding": "base64", "data": other}, {"path": ["y"], "data": big}]},
+        "c": {"buffers": [{"path": ["array"], "encoding": "base64", "data": "small"}]},
+        "d": {"buffers": [{"path": ["array"], "encoding": "base64", "data": "small"}]},
+    }
+    assert build_site.share_repeated_buffers(state) == 2000
+    assert state["a"]["buffers"][0]["data"] == big and state["b"]["buffers"][0]["data"] == other
+    assert state["b"]["buffers"][1] == {"path": ["y"], "data": "", "site_same_as": ["a", 0]}
+    assert state["d"]["buffers"][0]["data"] == "small"  # a small one costs less than its reference
+
+
+def test_the_reference_page_lists_the_public_names_with_the_sites_navigation():
+    import geomlib
+
+    nav = build_site.nav_html([{"file": "developing.html", "title": "Developing"}, {"file": "reference.html"}], 1)
+    page = build_site.reference_html(nav)
+    assert all(f'id="{name}"' in page for name in geomlib.__all__)
+    assert page.count('class="site-nav"') == 1 and page.count('class="site-nav bottom"') == 1
+    assert 'href="developing.html"' in page and "<title>geomlib reference" in page
+    assert '<a class="headerlink" href="#load_mesh" aria-label="link to load_mesh"></a>' in page
+    assert all("aria-label=" in a for a in re.findall(r"<a [^>]*>\s*</a>", page))  # every empty link named
+    assert not re.search(r"""(?:src=|href=)["'](?:https?:)?//[^"']+\.(?:js|css)""", page)
+
+
+def test_large_style_sheets_are_shared_files(tmp_path):
+    theme = "body { color: #111; }\n" * 1000
+    page = (
+        f'<html><head><style type="text/css">{theme}</style><style type="text/css">p {{ }}</style>'
+        f'<style type="text/css">{theme}.x {{ background: url(img.png); }}</style></head>'
+        f'<body><style type="text/css">{theme}</style></body></html>'
+    )
+    shared = build_site.share_styles(page, tmp_path)
+    (css,) = (tmp_path / "assets" / "site").glob("style-*.css")
+    assert css.read_text() == theme
+    link = f'<link rel="stylesheet" href="assets/site/{css.name}">'
+    assert shared.startswith(f"<html><head>{link}<style")  # in the same place, the small sheet kept
+    assert "url(img.png)" in shared and shared.count(theme) == 2  # a relative url(), and the body, untouched
+    assert build_site.share_styles(page, tmp_path) == shared

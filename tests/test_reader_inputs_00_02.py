@@ -17,6 +17,7 @@ from geomlib.teaching import surfaces
 
 NB00, NB01, NB02 = "00_getting_started.ipynb", "01_uniform_laplace_curvature.ipynb", "02_fundamental_forms.ipynb"
 NB01A = "01a_dig_deeper_tessellation.ipynb"
+NB02A = "02a_dig_deeper_principal_curvatures.ipynb"
 
 
 def test_saddle_height_stated_in_01_is_the_code():
@@ -89,9 +90,19 @@ def test_01a_high_ends_on_two_components(awkward):
     assert not run.notes, run.notes
 
 
-def test_02_spheroid_at_the_ends_of_the_ranges(awkward):
+def test_02_umbilic_and_a_long_ellipsoid_at_the_ends_of_the_ranges():
+    # b = c: (a, 0, 0) is an umbilic, kappa_n is flat; the section drawn along p_u
+    run = ran(NB02, A_NUM=3.0, B_NUM=0.2, C_NUM=0.2, PHI_DEGREES=0)
+    assert not run.notes, run.notes
+    assert "neither: b = c" in run.outputs_text()
+    run = ran(NB02, A_NUM=0.2, B_NUM=3.0, C_NUM=0.2, PHI_DEGREES=180)
+    assert not run.notes, run.notes
+    assert "bends more along $p_v$" in run.outputs_text()
+
+
+def test_02a_spheroid_and_a_flat_offset_mesh_at_the_ends_of_the_ranges(awkward):
     run = ran(
-        NB02,
+        NB02A,
         A_NUM=0.2,
         B_NUM=3.0,
         C_NUM=3.0,
@@ -99,9 +110,23 @@ def test_02_spheroid_at_the_ends_of_the_ranges(awkward):
         GENERIC_V=0.1,
         SUBDIVISIONS=1,
         MESH=awkward["y_up_millimetres"],
+        OFFSET_MESH=Raw('geomlib.data_path("plane.obj")'),
+        OFFSET_RANGE=0.5,
         SEED=0,
     )
     assert any("not all different" in n and "spheroid" in n for n in run.notes), run.notes
+    assert "never fold" in run.outputs_text()
+
+
+def test_02a_offsets_of_a_scan_with_holes(awkward):
+    run = ran(NB02A, OFFSET_MESH=awkward["scan_with_holes"], OFFSET_RANGE=5.0, GENERIC_V=3.04, SUBDIVISIONS=6, SEED=7)
+    assert any("not used by any face" in n and "remove_unreferenced_vertices" in n for n in run.notes), run.notes
+
+
+def test_02a_offsets_of_a_model_in_millimetres(awkward):
+    run = ran(NB02A, OFFSET_MESH=awkward["y_up_millimetres"])
+    # the sphere folds near its radius, 1000 mm; the largest discrete |kappa| overstates the curvature
+    assert len(run.notes) == 1 and "noisy at single vertices" in run.notes[0], run.notes
 
 
 @needs_course

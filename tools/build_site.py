@@ -3,9 +3,14 @@
     python3 workbook.py site                 # every notebook in notebooks/
     python tools/build_site.py --out DIR 00_getting_started.ipynb ...   # some of them
 
-Every notebook is executed with its default parameters (nbclient, widget state
-stored) and rendered as an HTML page (nbconvert's ``lab`` template); an index
-page lists them in reading order and each page links to the previous and next.
+Every notebook, core (``NN_*``) and appendix (``NNa_dig_deeper_*``), is executed
+with its default parameters (nbclient, widget state stored) and rendered as an HTML
+page (nbconvert's ``lab`` template). The README and the pages of docs/ (and
+benchmarks/README.md) follow, rendered from their markdown by the same template, and a
+reference page of geomlib's public names made from their docstrings by pdoc. An index
+page lists it all in reading order (00, 01, 01a, 02, ..., then the documentation and
+the reference), each page links to the previous and next, and a link to a notebook or
+markdown file of the workbook becomes a link to its page (``:func:`site_links```).
 The 3D views stay live in the page: the saved widget state is rendered by the
 Jupyter widgets HTML manager and pythreejs's browser code, both served from
 ``assets/`` in the site folder together with require.js and MathJax, so a page
@@ -66,6 +71,24 @@ import nbformat
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
+# the notebooks in reading order: each core notebook NN_* followed by its appendix NNa_*
+# (file names sort that way: "_" comes before "a")
+NOTEBOOK_GLOBS = ("[0-9][0-9]_*.ipynb", "[0-9][0-9]a_*.ipynb")
+# the markdown pages after the notebooks, in reading order (source -> page); every other
+# docs/*.md follows them (docs/engineering-NN.md, ...), then the reference page
+DOC_PAGES = {
+    "README.md": "about.html",
+    "docs/README.md": "docs.html",
+    "docs/install.md": "install.html",
+    "docs/grading.md": "grading.html",
+    "docs/experiments.md": "experiments.html",
+    "docs/website.md": "website.html",
+    "docs/developing.md": "developing.html",
+}
+DOC_PAGES_AFTER = {"benchmarks/README.md": "benchmarks.html"}
+IMAGES = "docs/images"  # pictures of the markdown pages, copied to images/ on the site
+REFERENCE = "reference.html"
+REFERENCE_TITLE = "geomlib reference: the public functions"
 OUT = ROOT / "build" / "site"
 CACHE = ROOT / "build" / "npm-cache"
 ASSETS = "assets"
@@ -363,7 +386,33 @@ def prepare_for_site(nb, recorded=None):
                 note = (KERNEL_NOTE if controls == 1 else KERNEL_NOTE_MANY) if not snapping else KERNEL_NOTE_OTHERS
                 outputs.append(_html_output(f'<p class="site-kernel-note">{html.escape(note)}</p>'))
         cell.outputs = outputs
+    share_repeated_buffers(state)
     return live
+
+
+def share_repeated_buffers(state):
+    """Save each binary buffer of the widget state once (in place); returns the bytes saved.
+
+    Views of one mesh hold the same arrays (its triangles, often its positions) in
+    models of their own: notebook 04's eight views of one creature repeated 5.6 MB of
+    buffers. A buffer seen before keeps its path and encoding, empty data, and
+    ``"site_same_as": [model id, index]`` naming the first copy; a script in the page's
+    footer (TEMPLATE) puts the data back before the widget manager reads the state, so
+    every model gets exactly the buffer it had.
+    """
+    first, saved = {}, 0
+    for mid, model in state.items():
+        for i, buffer in enumerate(model.get("buffers", [])):
+            data = buffer.get("data", "")
+            if len(data) < 1024:  # small buffers cost less than their reference
+                continue
+            if data in first:
+                buffer["data"] = ""
+                buffer["site_same_as"] = first[data]
+                saved += len(data)
+            else:
+                first[data] = [mid, i]
+    return saved
 
 
 def page_states(recorded):
@@ -418,6 +467,23 @@ details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 1
 {%- endblock body_header -%}
 {% block body_footer %}
 {{ resources.site_nav.replace('class="site-nav"', 'class="site-nav bottom"') }}
+<script>
+// buffers the build saved once (share_repeated_buffers) are copied back into the widget
+// state before the widget manager reads it (it renders on "load", after this)
+document.addEventListener("DOMContentLoaded", function () {
+  var script = document.querySelector('script[type="application/vnd.jupyter.widget-state+json"]');
+  if (!script || script.textContent.indexOf("site_same_as") < 0) return;
+  var saved = JSON.parse(script.textContent), state = saved.state;
+  Object.keys(state).forEach(function (id) {
+    (state[id].buffers || []).forEach(function (buffer) {
+      if (!buffer.site_same_as) return;
+      buffer.data = state[buffer.site_same_as[0]].buffers[buffer.site_same_as[1]].data;
+      delete buffer.site_same_as;
+    });
+  });
+  script.textContent = JSON.stringify(saved);
+});
+</script>
 {%- if resources.site_states %}
 <script type="application/json" id="site-states">{{ resources.site_states }}</script>
 <script src="%(states_js)s"></script>
@@ -466,6 +532,115 @@ def exporter():
     )
 
 
+def notebook_paths():
+    """Every notebook of the site, in reading order: 00, 01, 01a, 02, 02a, ..."""
+    return sorted({p for glob in NOTEBOOK_GLOBS for p in NOTEBOOKS.glob(glob)}, key=lambda p: p.name)
+
+
+def doc_pages():
+    """{repository path of a markdown page: its page file on the site}, in reading order."""
+    pages = {src: page for src, page in DOC_PAGES.items() if (ROOT / src).is_file()}
+    for path in sorted((ROOT / "docs").glob("*.md")):
+        pages.setdefault(path.relative_to(ROOT).as_posix(), path.stem + ".html")
+    pages.update({src: page for src, page in DOC_PAGES_AFTER.items() if (ROOT / src).is_file()})
+    return pages
+
+
+MD_LINK = re.compile(r"(!?)\[([^\]]*)\]\(([^)\s]+)\)")
+FENCE = re.compile(r"^\s*(```|~~~)")
+
+
+def site_links(markdown, source, targets):
+    """``markdown`` of the file ``source`` (repository path) with its relative links made
+    links of the site: a notebook or markdown page that has a page (``targets``: repository
+    path -> page file) links to that page (``05_explicit_smoothing.ipynb`` ->
+    ``05_explicit_smoothing.html``), a picture of docs/images/ to images/; a link to any other
+    file of the repository, which the site does not carry, becomes its text and path.
+    Links to the web, anchors on the same page, and code blocks are left as they are."""
+
+    def rewrite(m):
+        bang, text, target = m.groups()
+        if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
+            return m.group(0)
+        path, hash_, anchor = target.partition("#")
+        rel = (ROOT / source).parent.joinpath(path).resolve()
+        try:
+            rel = rel.relative_to(ROOT).as_posix()
+        except ValueError:
+            return m.group(0)
+        if rel in targets:
+            return f"{bang}[{text}]({targets[rel]}{hash_}{anchor})"
+        if rel.startswith(IMAGES + "/"):
+            return f"{bang}[{text}](images/{rel[len(IMAGES) + 1 :]})"
+        return text if text.strip("`") == rel else f"{text} (`{rel}`)"
+
+    out, fenced = [], False
+    for line in markdown.split("\n"):
+        if FENCE.match(line):
+            fenced = not fenced
+        out.append(line if fenced else MD_LINK.sub(rewrite, line))
+    return "\n".join(out)
+
+
+def link_targets(notebooks, docs):
+    """Repository path -> page file, for :func:`site_links`."""
+    targets = {f"notebooks/{p.name}": p.stem + ".html" for p in notebooks}
+    targets.update(docs)
+    return targets
+
+
+def markdown_notebook(source, targets):
+    """The markdown page ``source`` (repository path) as a notebook of one markdown cell,
+    its links made the site's: rendered like the notebooks' own text (the same theme,
+    formulas and code blocks), with no network."""
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_markdown_cell(site_links((ROOT / source).read_text(encoding="utf-8"), source, targets))]
+    return nb
+
+
+# a documentation page is mostly links in running text: underlined, so that they are told
+# apart from the text by more than their colour (WCAG 1.4.1)
+DOC_CSS = ".jp-RenderedMarkdown a { text-decoration: underline; }"
+
+# the site's navigation bars on pdoc's page (the notebooks' pages style them in TEMPLATE)
+REFERENCE_NAV_CSS = """nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
+  font-family: system-ui, sans-serif; font-size: 14px; border-bottom: 1px solid #ddd; }
+nav.site-nav.bottom { border-top: 1px solid #ddd; border-bottom: none; margin-top: 2em; }
+nav.site-nav { position: static; height: auto; width: auto; overflow: visible; }  /* pdoc fixes every nav */
+/* pdoc's greens on its grey signature boxes reach 4.0-4.4:1; this green, 6.4:1 (WCAG AA asks 4.5) */
+.pdoc { --def: #006400; }
+.pdoc .kc, .pdoc .bp, .pdoc .nb, .pdoc .k, .pdoc .kn, .pdoc .ow { color: #006400; }"""
+
+
+def reference_html(nav):
+    """The reference page: geomlib's public names (``geomlib.__all__``) with their
+    docstrings, rendered by pdoc from the installed package (no network), with the
+    site's navigation."""
+    import pdoc.doc
+    import pdoc.render
+
+    import geomlib
+
+    pdoc.render.configure(docformat="numpy", search=False, show_source=False, math=False, mermaid=False)
+    module = pdoc.doc.Module(geomlib)
+    page = pdoc.render.html_module(module, all_modules={"geomlib": module})
+    page = re.sub(r"<title>[^<]*</title>", f"<title>{html.escape(REFERENCE_TITLE)}</title>", page, count=1)
+    # pdoc's anchor beside each entry is an empty link: it gets a name a screen reader can say
+    page = re.sub(
+        r'<a class="headerlink" href="#([^"]+)"></a>',
+        lambda m: f'<a class="headerlink" href="#{m[1]}" aria-label="link to {m[1]}"></a>',
+        page,
+    )
+    style = f"<style>{REFERENCE_NAV_CSS}</style>"
+    # inside pdoc's main column: its module list is a fixed column on the left of a wide window
+    bottom = nav.replace('class="site-nav"', 'class="site-nav bottom"')
+    return (
+        page.replace("</head>", style + "\n</head>", 1)
+        .replace('<main class="pdoc">', '<main class="pdoc">\n' + nav, 1)
+        .replace("</main>", bottom + "\n</main>", 1)
+    )
+
+
 def nav_html(pages, i):
     def link(j, label):
         if 0 <= j < len(pages):
@@ -508,16 +683,26 @@ built. Other controls recompute only in JupyterLab; here they show their default
 <ol>
 {items}
 </ol>
+<h2>About the workbook, and its reference</h2>
+<p>How to install it, grade with it, run its experiments and work on it; and
+geomlib's public functions with their docstrings.</p>
+<ul>
+{documents}
+</ul>
 </body>
 </html>
 """
 
 
 def build(out=OUT, names=None, log=print):
-    """Build the site into ``out``; returns a list of pages (file, title, live views,
-    live sliders, bytes, seconds, cell errors); the list is also written to ``out/pages.json``."""
+    """Build the site into ``out``; returns a list of pages in reading order (file, title,
+    kind: notebook, appendix, doc or reference; live views, live sliders, bytes, seconds,
+    cell errors); the list is also written to ``out/pages.json``. ``names`` (file names in
+    notebooks/) builds those notebooks only, with every documentation page."""
     out = Path(out)
-    paths = [NOTEBOOKS / Path(n).name for n in names] if names else sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+    paths = [NOTEBOOKS / Path(n).name for n in names] if names else notebook_paths()
+    docs = doc_pages()
+    targets = link_targets(paths, docs)
     if out.exists() and any(out.iterdir()):
         if not (out / "pages.json").exists():
             raise SystemExit(
@@ -535,6 +720,13 @@ def build(out=OUT, names=None, log=print):
         log(f"executing {path.name} ...")
         nb, recorded = execute(path)
         live = prepare_for_site(nb, recorded)
+        source = f"notebooks/{path.name}"
+        for cell in nb.cells:
+            if cell.cell_type == "markdown":
+                cell.source = site_links(cell.source, source, targets)
+            for output in cell.get("outputs", []):  # text a cell shows as markdown (explain, notes)
+                if "text/markdown" in output.get("data", {}):
+                    output["data"]["text/markdown"] = site_links(output["data"]["text/markdown"], source, targets)
         sliders = [s for r in recorded.values() for s in r.get("sliders", [])]
         pages.append(
             {
@@ -552,6 +744,7 @@ def build(out=OUT, names=None, log=print):
             }
         )
         executed.append((nb, page_states(recorded)))
+        pages[-1]["kind"] = "appendix" if re.match(r"\d\da_", path.name) else "notebook"
         log(f"  {pages[-1]['seconds']} s, {live} live 3D views, {len(sliders)} precomputed sliders")
         for s in sliders:
             log(f"    {s['description']}: {len(s['values'])} states")
@@ -559,25 +752,76 @@ def build(out=OUT, names=None, log=print):
             log(f"    {s['description']}: not precomputed ({s['reason']})")
         for error in pages[-1]["errors"]:
             log(f"  ERROR in {error}")
+    for source, file in docs.items():
+        nb = markdown_notebook(source, targets)
+        pages.append(
+            {"file": file, "title": title_of(nb, Path(source).stem), "kind": "doc", "source": source}
+            | {"views": 0, "sliders": [], "left_out": [], "seconds": 0, "errors": []}
+        )
+        executed.append((nb, []))
+    if (ROOT / IMAGES).is_dir():
+        shutil.copytree(ROOT / IMAGES, out / "images")
+    pages.append(
+        {"file": REFERENCE, "title": REFERENCE_TITLE, "kind": "reference"}
+        | {"views": 0, "sliders": [], "left_out": [], "seconds": 0, "errors": []}
+    )
     page_exporter = exporter()
+    (out / REFERENCE).write_text(reference_html(nav_html(pages, len(pages) - 1)), encoding="utf-8")
+    pages[-1]["bytes"] = (out / REFERENCE).stat().st_size
     for i, (page, (nb, states)) in enumerate(zip(pages, executed)):
         resources = {"site_nav": nav_html(pages, i), "metadata": {"name": page["title"]}}
         if states:  # JSON inside <script>: "</" written as "<\/" so no text in it ends the element
             resources["site_states"] = json.dumps(states, separators=(",", ":")).replace("</", "<\\/")
         body, _ = page_exporter.from_notebook_node(nb, resources=resources)
-        (out / page["file"]).write_text(body, encoding="utf-8")
+        if page["kind"] == "doc":
+            body = body.replace("</head>", f"<style>{DOC_CSS}</style>\n</head>", 1)
+        (out / page["file"]).write_text(share_styles(body, out), encoding="utf-8")
         page["bytes"] = (out / page["file"]).stat().st_size
     items = "\n".join(
         f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a> '
         f'<span class="views">({p["views"]} live 3D view{"" if p["views"] == 1 else "s"}'
         f"{live_sliders_text(len(p['sliders']))})</span></li>"
         for p in pages
+        if p["kind"] in ("notebook", "appendix")
+    )
+    documents = "\n".join(
+        f'<li><a href="{p["file"]}">{html.escape(p["title"])}</a></li>'
+        for p in pages
+        if p["kind"] in ("doc", "reference")
     )
     (out / "index.html").write_text(
-        INDEX.format(title="Discrete curvature and Laplacian mesh processing", items=items), encoding="utf-8"
+        INDEX.format(title="Discrete curvature and Laplacian mesh processing", items=items, documents=documents),
+        encoding="utf-8",
     )
     (out / "pages.json").write_text(json.dumps(pages, indent=1))
     return pages
+
+
+SHARED_STYLE = 8192  # bytes: a style sheet of the page's head this large goes to a file of its own
+
+
+def share_styles(page, site):
+    """``page`` (HTML text) with each large style sheet of its head moved to a file in
+    ``site/assets/site/`` named by its hash, the ``<style>`` element replaced by a
+    ``<link>`` to it in the same place. nbconvert writes JupyterLab's theme (about
+    260 KB) into every page; shared, a browser reads it once, and the site is that much
+    smaller per page. Sheets that refer to other files (``url()`` or ``@import`` other than
+    ``data:``) stay in the page, where their relative addresses hold."""
+    end = page.find("</head>")
+
+    def move(m):
+        css = m.group(1)
+        if len(css) < SHARED_STYLE or re.search(r"@import|url\(\s*['\"]?(?!data:)", css):
+            return m.group(0)
+        name = f"{ASSETS}/site/style-{hashlib.sha256(css.encode()).hexdigest()[:12]}.css"
+        path = Path(site) / name
+        if not path.exists():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(css, encoding="utf-8")
+        return f'<link rel="stylesheet" href="{name}">'
+
+    head = re.sub(r'<style type="text/css">(.*?)</style>', move, page[:end], flags=re.S)
+    return head + page[end:]
 
 
 def live_sliders_text(n):
