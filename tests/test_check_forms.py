@@ -88,7 +88,7 @@ def test_forms_check_is_quick():
 @pytest.mark.parametrize("name", FORM_MISTAKES)
 def test_forms_diagnoses(name):
     fn, phrase = FORM_MISTAKES[name]
-    assert_diagnosed(check.fundamental_forms(fn), phrase, "Reread The definitions and Step 1")
+    assert_diagnosed(check.fundamental_forms(fn), phrase, "Reread The definitions and Steps 1-2")
 
 
 def test_forms_stub():

@@ -94,7 +94,7 @@ def _same(x, y):
 
 @exercise(
     "fundamental_forms",
-    reread="The definitions and Step 1 · the tangents p_u, p_v and the normal p_u x p_v / |p_u x p_v|",
+    reread="The definitions and Steps 1-2 · the tangents p_u, p_v and the inward normal p_u x p_v / |p_u x p_v| = -n",
     forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
 )
 def fundamental_forms(fn):
