@@ -30,6 +30,9 @@ SHORTCUTS = {
     "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
     "vertex_rms": geomlib.vertex_rms,
+    "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
+        V, F, sigma, tau, iterations, seed
+    )[0],
     "normal_curvature": lambda a, b, c, phi: symbolic.ellipsoid_normal_curvature(a, b, c, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
 }

@@ -13,6 +13,7 @@ from meshdata import COURSE, needs_course
 from notebook_runner import ran
 
 NB03, NB03A, NB04 = "03_cotangent_laplace.ipynb", "03a_dig_deeper_cotangent.ipynb", "04_spectral_reconstruction.ipynb"
+NB04A = "04a_dig_deeper_spectral.ipynb"
 
 
 def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
@@ -65,15 +66,20 @@ def test_03_cad_part_long_ellipsoid(tmp_path):
 
 def test_04_scan_with_unused_vertices(tmp_path):
     # issue 11: unused vertices gave divide-by-zero warnings, NaN in S, then an assert
-    run = ran(NB04, MESH=str(scan_with_holes(tmp_path)), K_VALUES=(1, 2, 30), SPHERE_LEVEL=3, SMALL_LEVEL=0)
-    run.assert_said("12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
-    text = run.outputs_text()
-    assert "divide by zero" not in text and "invalid value" not in text
+    for run in (
+        ran(NB04, MESH=str(scan_with_holes(tmp_path)), K_VALUES=(1, 2, 30), SPHERE_LEVEL=3),
+        ran(NB04A, MESH=str(scan_with_holes(tmp_path)), K_MAX=30, SMALL_LEVEL=0),  # k = n on 12 vertices
+    ):
+        run.assert_said("12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
+        text = run.outputs_text()
+        assert "divide by zero" not in text and "invalid value" not in text
 
 
 def test_04_two_components_k_beyond_n_and_high_ends(tmp_path):
-    run = ran(NB04, MESH=str(two_components(tmp_path)), K_VALUES=(5, 15, 5000), SPHERE_LEVEL=6, SMALL_LEVEL=3)
+    run = ran(NB04, MESH=str(two_components(tmp_path)), K_VALUES=(5, 15, 5000), SPHERE_LEVEL=6)
     run.assert_said("at most 1284 eigenvectors exist; k is capped at 1284")
+    run = ran(NB04A, MESH=str(two_components(tmp_path)), K_MAX=300, SMALL_LEVEL=3)  # k = n = 642 on the small mesh
+    assert "1284 vertices; 300 eigenpairs" in run.outputs_text()
 
 
 def test_04_y_up_millimetres(tmp_path):
