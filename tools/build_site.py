@@ -689,7 +689,7 @@ def markdown_notebook(source, targets):
 
 # a documentation page is mostly links in running text: underlined, so that they are told
 # apart from the text by more than their colour (WCAG 1.4.1)
-DOC_CSS = ".jp-RenderedMarkdown a { text-decoration: underline; }"
+DOC_CSS = ".jp-RenderedMarkdown a:link, .jp-RenderedMarkdown a:visited { text-decoration: underline; }"
 
 # the site's navigation bars on pdoc's page (the notebooks' pages style them in TEMPLATE)
 REFERENCE_NAV_CSS = """nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
