@@ -84,6 +84,7 @@ _EXPORTS = {
     "ImplicitSmoother": "lessons.smoothing",
     # noise and evaluation
     "add_noise": "lessons.noise",
+    "denoising_experiment": "lessons.noise",
     "bounding_box_diagonal": "mesh.geometry",
     "vertex_rms": "lessons.metrics",
     "hausdorff_distance": "lessons.metrics",

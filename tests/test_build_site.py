@@ -59,14 +59,70 @@ def test_controls_are_disabled_and_noted():
     nb, state = _notebook()
     assert build_site.prepare_for_site(nb) == 2
     assert state["slider"]["state"]["disabled"] is True
-    first = nb.cells[0].outputs  # view, its hidden still, the note
-    assert len(first) == 3 and build_site.WIDGET_VIEW in first[0]["data"]
+    first = nb.cells[0].outputs  # view, its hidden still, the keys that move it, the note
+    assert len(first) == 4 and build_site.WIDGET_VIEW in first[0]["data"]
     assert 'class="site-still" hidden' in first[1]["data"]["text/html"]
     assert "base64,iVBORw0KGgo=" in first[1]["data"]["text/html"]
-    assert build_site.KERNEL_NOTE in first[2]["data"]["text/html"]
+    assert build_site.VIEW_KEYS in first[2]["data"]["text/html"]
+    assert build_site.KERNEL_NOTE in first[3]["data"]["text/html"]
     # no control in the second cell: no note; the label has no still
-    assert len(nb.cells[1].outputs) == 3
+    assert len(nb.cells[1].outputs) == 4
     assert all("site-kernel-note" not in str(o) for o in nb.cells[1].outputs)
+
+
+def test_stills_and_figures_keep_their_alt_text():
+    nb, state = _notebook()
+    nb.cells[0].outputs[0]["metadata"] = {"image/png": {"alt": 'A view of "H" & K'}}
+    figure = nbformat.v4.new_output(
+        "display_data",
+        data={"image/png": "iVBORw0KGgo=", "text/plain": "Figure"},
+        metadata={"image/png": {"alt": "a plot"}},
+    )
+    state["out"] = _model("OutputModel", module="@jupyter-widgets/output", outputs=[figure])
+    build_site.prepare_for_site(nb)
+    assert 'alt="A view of &quot;H&quot; &amp; K"' in nb.cells[0].outputs[1]["data"]["text/html"]
+    assert 'alt="still picture of the 3D view"' in nb.cells[1].outputs[1]["data"]["text/html"]  # no metadata
+    (shown,) = state["out"]["state"]["outputs"]
+    assert shown["data"]["text/html"] == '<img src="data:image/png;base64,iVBORw0KGgo=" alt="a plot">'
+    assert "image/png" not in shown["data"]
+    # a page's own figures: the template writes the alt of the output's metadata
+    page = nbformat.v4.new_notebook()
+    page.cells = [nbformat.v4.new_code_cell("fig")]
+    page.cells[0].outputs = [figure, nbformat.v4.new_output("display_data", data={"image/png": "iVBORw0KGgo="})]
+    body, _ = build_site.exporter().from_notebook_node(page, resources={"site_nav": "", "metadata": {"name": "t"}})
+    assert body.count('alt="a plot"') == 1
+    assert body.count("No description has been provided") == 1  # the figure without alt is not given one
+
+
+def test_pages_have_a_skip_link_a_live_region_and_labelled_navigation():
+    nb, _ = _notebook()
+    nav = build_site.nav_html([{"file": "a.html", "title": "A"}, {"file": "b.html", "title": "B"}], 0)
+    body, _ = build_site.exporter().from_notebook_node(nb, resources={"site_nav": nav, "metadata": {"name": "t"}})
+    assert body.index(build_site.SKIP_LINK) < body.index("<main") < body.index("</main>")
+    assert '<main id="site-content"' in body and 'aria-live="polite"' in body
+    navs = re.findall(r"<nav [^>]*>", body)
+    assert len(navs) == 2 and all("aria-label=" in n for n in navs)
+    main = body[body.index("<main") : body.index("</main>")]
+    assert "<nav" not in main  # both bars outside the content the skip link jumps to
+    assert "inTabOrder: false" in body and build_site.A11Y_JS in body
+
+
+def test_theme_colours_meet_wcag_aa():
+    def luminance(hex_colour):
+        rgb = [int(hex_colour[i : i + 2], 16) / 255 for i in (1, 3, 5)]
+        rgb = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in rgb]
+        return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+
+    def contrast(a, b):
+        hi, lo = sorted((luminance(a), luminance(b)), reverse=True)
+        return (hi + 0.05) / (lo + 0.05)
+
+    colours = dict(re.findall(r"--jp-([a-z-]+-color): (#[0-9a-f]{6})", build_site.A11Y_CSS))
+    assert len(colours) >= 12
+    for name, colour in colours.items():  # code on the cells' grey, prompts on white
+        assert contrast(colour, "#f5f5f5" if "mirror" in name else "#ffffff") >= 4.5, (name, colour)
+    track = re.search(r"\.noUi-target \{ background: (#[0-9a-f]{6})", build_site.A11Y_CSS)[1]
+    assert contrast(track, "#ffffff") >= 3.0  # a slider's track against the page (WCAG 1.4.11)
 
 
 def test_several_controls_get_one_plural_note():
@@ -191,3 +247,81 @@ def test_the_states_are_on_the_page_and_cannot_end_their_script():
     assert f'<script src="{build_site.STATES_JS}">' in body
     (inside,) = re.findall(r'<script[^>]*id="site-states"[^>]*>(.*?)</script>', body, re.S)
     assert json.loads(inside) == states
+
+
+def test_links_become_the_sites_pages():
+    targets = {
+        "notebooks/05_explicit_smoothing.ipynb": "05_explicit_smoothing.html",
+        "docs/install.md": "install.html",
+        "README.md": "about.html",
+    }
+    text = (
+        "See [05](05_explicit_smoothing.ipynb#The-limit), [install](../docs/install.md), "
+        "[home](../README.md), ![a view](../docs/images/front.png), [the tool](../tools/build_site.py), "
+        "[`tools/run_notebook.py`](../tools/run_notebook.py), [web](https://example.org/x.md), [here](#top)\n"
+        "```bash\n[05](05_explicit_smoothing.ipynb)\n```"
+    )
+    assert build_site.site_links(text, "notebooks/04_spectral_reconstruction.ipynb", targets) == (
+        "See [05](05_explicit_smoothing.html#The-limit), [install](install.html), "
+        "[home](about.html), ![a view](images/front.png), the tool (`tools/build_site.py`), "
+        "`tools/run_notebook.py`, [web](https://example.org/x.md), [here](#top)\n"
+        "```bash\n[05](05_explicit_smoothing.ipynb)\n```"
+    )
+
+
+def test_reading_order_puts_each_appendix_after_its_core(tmp_path, monkeypatch):
+    for name in ("01a_dig_deeper_x.ipynb", "00_start.ipynb", "01_one.ipynb", "02_two.ipynb", "notes.ipynb"):
+        (tmp_path / name).write_text("{}")
+    monkeypatch.setattr(build_site, "NOTEBOOKS", tmp_path)
+    assert [p.name for p in build_site.notebook_paths()] == [
+        "00_start.ipynb",
+        "01_one.ipynb",
+        "01a_dig_deeper_x.ipynb",
+        "02_two.ipynb",
+    ]
+    pages = list(build_site.doc_pages())
+    assert pages[:3] == ["README.md", "docs/README.md", "docs/install.md"] and pages[-1] == "benchmarks/README.md"
+    assert {p.relative_to(build_site.ROOT).as_posix() for p in (build_site.ROOT / "docs").glob("*.md")} <= set(pages)
+
+
+def test_repeated_buffers_are_saved_once_and_name_their_first_copy():
+    big, other = "A" * 2000, "B" * 2000
+    state = {
+        "a": {"buffers": [{"path": ["array"], "encoding": "base64", "data": big}]},
+        "b": {"buffers": [{"path": ["x"], "encoding": "base64", "data": other}, {"path": ["y"], "data": big}]},
+        "c": {"buffers": [{"path": ["array"], "encoding": "base64", "data": "small"}]},
+        "d": {"buffers": [{"path": ["array"], "encoding": "base64", "data": "small"}]},
+    }
+    assert build_site.share_repeated_buffers(state) == 2000
+    assert state["a"]["buffers"][0]["data"] == big and state["b"]["buffers"][0]["data"] == other
+    assert state["b"]["buffers"][1] == {"path": ["y"], "data": "", "site_same_as": ["a", 0]}
+    assert state["d"]["buffers"][0]["data"] == "small"  # a small one costs less than its reference
+
+
+def test_the_reference_page_lists_the_public_names_with_the_sites_navigation():
+    import geomlib
+
+    nav = build_site.nav_html([{"file": "developing.html", "title": "Developing"}, {"file": "reference.html"}], 1)
+    page = build_site.reference_html(nav)
+    assert all(f'id="{name}"' in page for name in geomlib.__all__)
+    assert page.count('class="site-nav"') == 1 and page.count('class="site-nav bottom"') == 1
+    assert 'href="developing.html"' in page and "<title>geomlib reference" in page
+    assert '<a class="headerlink" href="#load_mesh" aria-label="link to load_mesh"></a>' in page
+    assert all("aria-label=" in a for a in re.findall(r"<a [^>]*>\s*</a>", page))  # every empty link named
+    assert not re.search(r"""(?:src=|href=)["'](?:https?:)?//[^"']+\.(?:js|css)""", page)
+
+
+def test_large_style_sheets_are_shared_files(tmp_path):
+    theme = "body { color: #111; }\n" * 1000
+    page = (
+        f'<html><head><style type="text/css">{theme}</style><style type="text/css">p {{ }}</style>'
+        f'<style type="text/css">{theme}.x {{ background: url(img.png); }}</style></head>'
+        f'<body><style type="text/css">{theme}</style></body></html>'
+    )
+    shared = build_site.share_styles(page, tmp_path)
+    (css,) = (tmp_path / "assets" / "site").glob("style-*.css")
+    assert css.read_text() == theme
+    link = f'<link rel="stylesheet" href="assets/site/{css.name}">'
+    assert shared.startswith(f"<html><head>{link}<style")  # in the same place, the small sheet kept
+    assert "url(img.png)" in shared and shared.count(theme) == 2  # a relative url(), and the body, untouched
+    assert build_site.share_styles(page, tmp_path) == shared

@@ -116,20 +116,22 @@ def test_reference_noise_passes_quickly():
     assert time.perf_counter() - start < 1.0
 
 
-def test_geomlib_add_noise_passes():
-    assert check.add_noise(lambda V, F, sigma, seed: geomlib.add_noise(V, F, sigma, seed)).passed
+def test_rng_normal_with_a_scale_passes_too():
+    def normal(V, F, sigma, seed):
+        return V + np.random.default_rng(seed).normal(0.0, sigma * bounding_box_diagonal(V), V.shape)
+
+    assert check.add_noise(normal).passed
 
 
 @pytest.mark.parametrize("name", sorted(WRONG_NOISE))
 def test_wrong_noise_is_diagnosed(name):
     fn, phrase = WRONG_NOISE[name]
-    assert_diagnosed(check.add_noise(fn), phrase, "Reread section 2 · The noise model")
+    assert_diagnosed(check.add_noise(fn), phrase, "Reread section 2 · The noise, yours")
 
 
 def test_reference_rms_passes():
     result = check.vertex_rms(rms_reference)
     assert result.passed, result.message
-    assert check.vertex_rms(lambda V, W: geomlib.vertex_rms(V, W)).passed
 
 
 def test_rms_has_exact_answer_on_the_tetrahedron():
@@ -142,10 +144,10 @@ def test_rms_has_exact_answer_on_the_tetrahedron():
 @pytest.mark.parametrize("name", sorted(WRONG_RMS))
 def test_wrong_rms_is_diagnosed(name):
     fn, phrase = WRONG_RMS[name]
-    assert_diagnosed(check.vertex_rms(fn), phrase, "Reread section 3 · The metrics")
+    assert_diagnosed(check.vertex_rms(fn), phrase, "Reread section 3 · The error, yours")
 
 
-@pytest.mark.parametrize("exercise", [check.add_noise, check.vertex_rms])
+@pytest.mark.parametrize("exercise", [check.add_noise, check.vertex_rms, check.denoising_experiment])
 def test_stub_is_not_written_yet(exercise):
     def stub(*args):
         raise NotImplementedError("Your turn")
@@ -157,3 +159,123 @@ def test_strict_mode_raises_for_written_wrong_function(monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
     with pytest.raises(check.CheckFailed, match="not relative"):
         check.vertex_rms(WRONG_RMS["not relative"][0])
+
+
+# --- the experiment: noise, implicit smoothing, the error against the clean mesh ---------------
+
+
+def _rms(P, V):
+    return float(np.sqrt(np.mean(np.sum((P - V) ** 2, axis=1))))
+
+
+def experiment(noise, measure, smooth_noisy=True):
+    """An experiment from its parts, written fresh: noise(V, sigma, seed) -> W, measure(P, W, V) -> float."""
+
+    def fn(V, F, sigma, tau, iterations, seed):
+        W = noise(V, sigma, seed)
+        P = geomlib.implicit_smoothing(W if smooth_noisy else V, F, tau, iterations)
+        return measure(P, W, V)
+
+    return fn
+
+
+def seeded(V, sigma, seed):
+    return V + sigma * bounding_box_diagonal(V) * np.random.default_rng(seed).standard_normal(V.shape)
+
+
+def relative(P, W, V):
+    return _rms(P, V) / bounding_box_diagonal(V)
+
+
+def edge_noise(V, F, sigma, tau, iterations, seed):
+    ell = np.linalg.norm(V[F[:, [1, 2, 0]]] - V[F], axis=2).mean()  # every edge twice on a closed mesh: the mean edge
+    W = V + sigma * ell * np.random.default_rng(seed).standard_normal(V.shape)
+    return relative(geomlib.implicit_smoothing(W, F, tau, iterations), W, V)
+
+
+# correct variants: another draw of the same noise, columns drawn first, a float32 error
+RIGHT_EXPERIMENTS = {
+    "reference": experiment(seeded, relative),
+    "rng.normal": experiment(
+        lambda V, s, seed: V + np.random.default_rng(seed).normal(0, s * bounding_box_diagonal(V), V.shape), relative
+    ),
+    "columns first": experiment(
+        lambda V, s, seed: (
+            V + s * bounding_box_diagonal(V) * np.random.default_rng(seed + 1).standard_normal((3, len(V))).T
+        ),
+        relative,
+    ),
+    "float32 error": experiment(seeded, lambda P, W, V: np.float32(relative(P, W, V))),
+}
+
+WRONG_EXPERIMENTS = {
+    "against the noisy mesh": (
+        experiment(seeded, lambda P, W, V: _rms(P, W) / bounding_box_diagonal(V)),
+        "against the noisy mesh",
+    ),
+    "unseeded": (
+        experiment(lambda V, s, seed: V + s * bounding_box_diagonal(V) * np.random.standard_normal(V.shape), relative),
+        "not seeded",
+    ),
+    "seed ignored": (experiment(lambda V, s, seed: seeded(V, s, 0), relative), "seed is ignored"),
+    "absolute error": (experiment(seeded, lambda P, W, V: _rms(P, V)), "error is absolute"),
+    "noise not relative": (
+        experiment(lambda V, s, seed: V + s * np.random.default_rng(seed).standard_normal(V.shape), relative),
+        "noise is not relative to the bounding-box diagonal",
+    ),
+    "noise by the edge length": (edge_noise, "mean edge length"),
+    "noise and error both absolute": (
+        experiment(
+            lambda V, s, seed: V + s * np.random.default_rng(seed).standard_normal(V.shape), lambda P, W, V: _rms(P, V)
+        ),
+        "not both relative",
+    ),
+    "the noisy mesh measured": (
+        experiment(seeded, lambda P, W, V: relative(W, W, V)),
+        "error is that of the noisy mesh",
+    ),
+    "the clean mesh smoothed": (experiment(seeded, relative, smooth_noisy=False), "clean mesh was smoothed"),
+    "a random direction of length sigma d": (
+        experiment(
+            lambda V, s, seed: (
+                V
+                + s
+                * bounding_box_diagonal(V)
+                * (lambda X: X / np.linalg.norm(X, axis=1, keepdims=True))(
+                    np.random.default_rng(seed).standard_normal(V.shape)
+                )
+            ),
+            relative,
+        ),
+        "too small in square",
+    ),
+    "returns the meshes": (experiment(seeded, lambda P, W, V: (relative(P, W, V), P)), "not a number"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(RIGHT_EXPERIMENTS))
+def test_correct_experiments_pass(name):
+    result = check.denoising_experiment(RIGHT_EXPERIMENTS[name])
+    assert result.passed, result.message
+
+
+@pytest.mark.parametrize("name", sorted(WRONG_EXPERIMENTS))
+def test_wrong_experiments_are_diagnosed(name):
+    fn, phrase = WRONG_EXPERIMENTS[name]
+    assert_diagnosed(check.denoising_experiment(fn), phrase, "Reread section 4 · The experiment, yours")
+
+
+def test_typical_experiment_mistakes_earn_partial_credit_and_catch_alls_do_not():
+    assert check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["against the noisy mesh"][0]).partial
+    assert check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["unseeded"][0]).partial
+    assert not check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["returns the meshes"][0]).partial
+
+
+def test_the_experiment_is_scale_free_and_its_error_at_zero_iterations_is_the_noise():
+    V, F = geomlib.load_mesh(geomlib.data_path("sphere.obj"))
+    E, W, P = geomlib.denoising_experiment(V, F, 0.02, 0.0, 0, seed=4)
+    assert np.array_equal(P, W) and E == pytest.approx(np.sqrt(3) * 0.02, rel=0.03)  # sqrt(3) sigma, statistically
+    tau = 0.1 * geomlib.mean_edge_length(V, F) ** 2
+    E1 = geomlib.denoising_experiment(V, F, 0.02, tau, 3, seed=4)[0]
+    E2 = geomlib.denoising_experiment(7 * V, F, 0.02, 49 * tau, 3, seed=4)[0]
+    assert E1 == pytest.approx(E2, rel=1e-9) and E1 < E

@@ -11,6 +11,7 @@ import pytest
 
 import geomlib
 import geomlib.lessons.smoothing as smoothing
+import geomlib.lessons.spectral as spectral
 import geomlib.lessons.symbolic as symbolic
 from geomlib import check
 from geomlib.teaching.check.result import reveal
@@ -22,11 +23,16 @@ SHORTCUTS = {
     "vertex_areas": lambda V, F: geomlib.vertex_areas(V, F),
     "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
     "spectral_reconstruction": lambda V, F, k: geomlib.spectral_reconstruction(V, F, k, cache=False),
+    "eigenpairs": lambda M, C, k: spectral.eigenpairs(M, C, k),
     "explicit_step": smoothing.explicit_step,
     "explicit_step_limit": geomlib.explicit_step_limit,
     "implicit_step": smoothing.implicit_step,
+    "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
     "vertex_rms": geomlib.vertex_rms,
+    "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
+        V, F, sigma, tau, iterations, seed
+    )[0],
     "normal_curvature": lambda a, b, c, phi: symbolic.ellipsoid_normal_curvature(a, b, c, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
 }

@@ -9,7 +9,7 @@
   ``lab`` extra's pins are the same.
 * environment.yml asks conda only for Python and pip (packages conda-forge has
   under those names) and pip for exactly what workbook.py installs.
-* The Python version tested (environment.yml, README) is one the package declares.
+* The Python version tested (environment.yml, docs/install.md, README) is one the package declares.
 """
 
 import ast
@@ -200,14 +200,15 @@ def test_environment_yml_pip_section_installs_what_workbook_py_installs():
     assert "--no-deps" not in args
 
 
-def test_tested_python_is_declared_and_stated_in_the_readme():
+def test_tested_python_is_declared_and_stated_in_the_install_page():
     _, conda, _ = _environment()
     (python,) = [dep for dep in conda if dep.startswith("python")]
     tested = re.fullmatch(r"python\s*=\s*(\d+\.\d+)", python).group(1)
     assert SpecifierSet(_project()["requires-python"]).contains(f"{tested}.0")
-    readme = (ROOT / "README.md").read_text()
-    assert f"tested with Python {tested}" in readme
-    assert f'requires-python = "{_project()["requires-python"]}"' in readme
+    install = (ROOT / "docs" / "install.md").read_text()
+    assert f"tested with Python {tested}" in install
+    assert f'requires-python = "{_project()["requires-python"]}"' in install
+    assert f"Python {tested}" in (ROOT / "README.md").read_text()  # the front page's two commands
 
 
 def test_workbook_opens_notebook_00_and_passes_arguments_on():

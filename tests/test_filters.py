@@ -60,3 +60,20 @@ def test_explicit_damps_more_than_diffusion_in_magnitude_only_below_x_1_2785():
     assert (np.abs(explicit[x < 1.278]) < diffusion[x < 1.278]).all()
     assert np.isclose(abs(mode_factor(1.8, 1.0, "explicit")), 0.8)
     assert np.isclose(mode_factor(1.8, 1.0, "diffusion"), 0.1653, atol=1e-4)
+
+
+def test_no_curve_is_told_apart_by_colour_alone():
+    ax = plot_mode_factors(2.0, 50.0, 0.01, taubin=(0.01, -0.0105), past=0.05)
+    looks = [
+        (line.get_linestyle(), line.get_marker()) for line in ax.get_lines() if not line.get_label().startswith("_")
+    ]
+    assert len(looks) == len(set(looks)) == 7
+
+
+def test_a_step_past_the_limit_is_drawn_with_the_point_where_it_leaves_the_band():
+    ax = plot_mode_factors(2.0, 50.0, 0.01, past=1.1 * 2 / 50.0)
+    marks = [line for line in ax.get_lines() if line.get_label().startswith("leaves")]
+    assert len(marks) == 1
+    (lam,), (factor,) = marks[0].get_data()
+    assert np.isclose(lam, 50.0 / 1.1) and factor == -1.0 and lam < 50.0  # inside the band: it diverges
+    assert np.isclose(mode_factor(lam, 1.1 * 2 / 50.0, "explicit"), -1.0)

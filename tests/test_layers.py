@@ -1,4 +1,4 @@
-"""The layer rule of geomlib (README, "Architecture"), held by reading every module's imports.
+"""The layer rule of geomlib (docs/developing.md, "Architecture: four layers"), held by reading every module's imports.
 
 mesh (the core) imports no other layer; numerics imports the mesh core; lessons import the
 mesh core and numerics; teaching aids may import anything. No module imports a private name

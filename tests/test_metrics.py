@@ -332,6 +332,21 @@ def test_opening_a_hinge_by_delta_gives_sharp_edge_error_delta(delta):
     assert np.isnan(sharp_edge_error(hinge(20.0 + delta), hinge(20.0), F))
 
 
+def test_the_sharp_edge_error_is_of_the_signed_bend_so_a_fold_turned_over_counts_whole():
+    """The text of 07a defines theta_e as the signed bend: +90 at a cube's (convex) edge, -90 in a notch, 0 flat.
+    A concave 60-degree fold turned into a convex one is off by 120 degrees, more than any unsigned angle
+    between normals could be off (at most 60 here): the error can exceed 90 degrees."""
+
+    def hinge(bend):  # the fold of the test above; a negative bend folds the other way (concave)
+        b = np.radians(bend)
+        return np.array([[0.0, 0, 0], [1, 0, 0], [0.5, -1, 0], [0.5, np.cos(b), -np.sin(b)]])
+
+    F = np.array([[0, 2, 1], [0, 1, 3]])
+    assert dihedral_angles(hinge(-60.0), F)[1] == pytest.approx([-60.0])
+    assert sharp_edge_error(hinge(60.0), hinge(-60.0), F) == pytest.approx(120.0)
+    assert sharp_edge_error(hinge(-100.0), hinge(100.0), F) == pytest.approx(200.0)
+
+
 def test_interior_edges_of_an_open_grid():
     V, F = grid(4)  # 3 x 3 squares
     E, f1, f2, boundary, other = interior_edges(F)

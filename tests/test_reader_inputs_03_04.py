@@ -12,7 +12,8 @@ from awkward_meshes import cad_part, scan_with_holes, two_components, y_up_milli
 from meshdata import COURSE, needs_course
 from notebook_runner import ran
 
-NB03, NB04 = "03_cotangent_laplace.ipynb", "04_spectral_reconstruction.ipynb"
+NB03, NB03A, NB04 = "03_cotangent_laplace.ipynb", "03a_dig_deeper_cotangent.ipynb", "04_spectral_reconstruction.ipynb"
+NB04A = "04a_dig_deeper_spectral.ipynb"
 
 
 def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
@@ -32,9 +33,10 @@ def test_03_scan_with_small_jitter_and_low_ends(tmp_path):
         "geomlib.mesh.repair.remove_unreferenced_vertices",
         "does not converge on jittered meshes",
         "JITTER = 0.1",
-        "VIEW_LEVEL = 1",
-        "SADDLE_JITTER = 0.0",
     )
+    # the principal curvatures and the saddle are in the appendix
+    run = ran(NB03A, MESH=str(scan_with_holes(tmp_path)), VIEW_LEVEL=1, SADDLE_N=8, SADDLE_JITTER=0.0)
+    run.assert_said("12 vertices are not used by any face", "VIEW_LEVEL = 1", "SADDLE_JITTER = 0.0")
 
 
 def test_03_two_components_sphere_axes_and_high_ends(tmp_path):
@@ -51,6 +53,8 @@ def test_03_two_components_sphere_axes_and_high_ends(tmp_path):
     )
     run.assert_said("A slope needs at least two levels")
     assert not re.search(r"\bnan\b", run.outputs_text()), "a number printed as nan"
+    run = ran(NB03A, MESH=str(two_components(tmp_path)), AXES=(1.0, 1.0, 1.0), VIEW_LEVEL=5, SADDLE_N=200, SEED=7)
+    assert not re.search(r"\bnan\b", run.outputs_text()), "a number printed as nan"
 
 
 def test_03_cad_part_long_ellipsoid(tmp_path):
@@ -62,15 +66,20 @@ def test_03_cad_part_long_ellipsoid(tmp_path):
 
 def test_04_scan_with_unused_vertices(tmp_path):
     # issue 11: unused vertices gave divide-by-zero warnings, NaN in S, then an assert
-    run = ran(NB04, MESH=str(scan_with_holes(tmp_path)), K_VALUES=(1, 2, 30), SPHERE_LEVEL=3, SMALL_LEVEL=0)
-    run.assert_said("12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
-    text = run.outputs_text()
-    assert "divide by zero" not in text and "invalid value" not in text
+    for run in (
+        ran(NB04, MESH=str(scan_with_holes(tmp_path)), K_VALUES=(1, 2, 30), SPHERE_LEVEL=3),
+        ran(NB04A, MESH=str(scan_with_holes(tmp_path)), K_MAX=30, SMALL_LEVEL=0),  # k = n on 12 vertices
+    ):
+        run.assert_said("12 vertices are not used by any face", "geomlib.mesh.repair.remove_unreferenced_vertices")
+        text = run.outputs_text()
+        assert "divide by zero" not in text and "invalid value" not in text
 
 
 def test_04_two_components_k_beyond_n_and_high_ends(tmp_path):
-    run = ran(NB04, MESH=str(two_components(tmp_path)), K_VALUES=(5, 15, 5000), SPHERE_LEVEL=6, SMALL_LEVEL=3)
+    run = ran(NB04, MESH=str(two_components(tmp_path)), K_VALUES=(5, 15, 5000), SPHERE_LEVEL=6)
     run.assert_said("at most 1284 eigenvectors exist; k is capped at 1284")
+    run = ran(NB04A, MESH=str(two_components(tmp_path)), K_MAX=300, SMALL_LEVEL=3)  # k = n = 642 on the small mesh
+    assert "1284 vertices; 300 eigenpairs" in run.outputs_text()
 
 
 def test_04_y_up_millimetres(tmp_path):
@@ -81,6 +90,7 @@ def test_04_y_up_millimetres(tmp_path):
 @needs_course
 def test_03_course_lilium():
     ran(NB03, MESH=str(COURSE / "curvatures" / "lilium_s.obj"), LEVELS=[1, 2, 3])
+    ran(NB03A, MESH=str(COURSE / "curvatures" / "lilium_s.obj"))
 
 
 @needs_course

@@ -420,6 +420,33 @@ def test_step_past_limit_warns_once_naming_the_limit():
         explicit_smoothing(V, F, 0.999 * limit, 3)  # no warning below the limit
 
 
+def distorted_plane():
+    """A 7 x 7 grid with every vertex (boundary too) moved in-plane: 24 negative cotangent weights."""
+    V, F = grid(7)
+    V[:, :2] += 0.35 / 6 * np.random.default_rng(183).uniform(-1, 1, (49, 2))
+    return V, F
+
+
+def test_a_step_past_the_limit_warns_where_negative_weights_beat_the_short_bound():
+    # Gershgorin's short form max 2|C_ii|/M_ii bounds lam_max only when no weight is negative;
+    # here it lies below lam_max, so a step between the two limits must still be caught at once
+    V, F = distorted_plane()
+    M, C = laplacian(V, F)
+    m, c = M.diagonal(), C.diagonal()
+    assert int((C.data < 0).sum() - (c < 0).sum()) // 2 == 24
+    lam_max = 2 / explicit_step_limit(V, F, boundary_condition="free")
+    short, true = (2 * np.abs(c) / m).max(), (abs(C).sum(axis=1).A1 / m).max()
+    assert short < lam_max / 1.1 and lam_max < true  # 3188 < 3538 < 4618
+    tau = 1.008 * 2 / lam_max
+    assert tau * short < 2  # the short bound alone would call this step safe
+    seen = []
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        explicit_smoothing(V, F, tau, 200, boundary_condition="free", callback=lambda k, P: seen.append(len(record)))
+    assert seen[0] == 1 and "exceeds the stability limit" in str(record[0].message)  # before iteration 1
+    assert [issubclass(w.category, MeshWarning) for w in record] == [True]
+
+
 def test_explicit_smoother_gives_explicit_smoothing_for_every_step_from_one_operator():
     V, F = grid(9, jitter=0.2)
     smoother = ExplicitSmoother(V, F)

@@ -662,8 +662,10 @@ def sharp_edge_error(V, V_clean, F, threshold=SHARP_ANGLE, edges=None):
 
     The sharp edges are the interior edges where the clean mesh bends by more
     than ``threshold`` degrees (default 30); on those the error is
-    ``|theta(V) - theta(V_clean)|`` with the signed bend angle of
-    :func:`dihedral_angles`. Returns NaN when the clean mesh has no sharp
+    ``|theta(V) - theta(V_clean)|`` with the *signed* bend angle of
+    :func:`dihedral_angles` (+90 at a cube's convex edge, -90 at a concave one), so an
+    edge that turned over counts the whole turn and the error can exceed 90 degrees
+    (a concave 60-degree fold made convex: 120). Returns NaN when the clean mesh has no sharp
     edge (there is nothing to measure). ``edges``: ``(E, f1, f2)`` of
     :func:`interior_edges` for F (or any subset that holds the sharp edges),
     to avoid recomputing them.

@@ -41,7 +41,9 @@ __all__ = ["LaplaceOperator", "laplace_operator", "BOUNDARY_CONDITIONS", "SOLVER
 BOUNDARY_CONDITIONS = ("fixed", "free")
 
 #: How an implicit step's system is solved: a sparse Cholesky factorisation, or
-#: conjugate gradients with a Jacobi preconditioner (Desbrun et al. 1999).
+#: conjugate gradients with a Jacobi preconditioner. (Desbrun et al. 1999 solved their
+#: system with a preconditioned bi-conjugate gradient, as their operator M^-1 C is not
+#: symmetric; multiplied by M, as here, the system is symmetric and plain CG applies.)
 SOLVERS = ("cholesky", "cg")
 
 #: Operators kept in memory (each about 40 MB at 164k vertices).

@@ -373,10 +373,13 @@ class ExplicitSmoother:
             fraction = _check_tau(step_fraction, "step_fraction")
             return fraction * 2.0 / L.lam_max if L.lam_max > 0 else 0.0
         tau = _check_tau(tau)
-        # Gershgorin: lam_max <= max 2 |C_ii| / M_ii, so steps below 2 / that bound are
-        # certainly stable and need no eigenvalue computation (L.lam_max computes it on first use).
-        m, c = L.m[L.moving], np.abs(L.C.diagonal()[L.moving])
-        if tau > 0 and L.moving.any() and tau * np.max(2.0 * c / m) > 2.0:
+        # Gershgorin on the rows of M^-1 C: lam_max <= max_i (|C_ii| + sum_j!=i |C_ij|) / M_ii, so
+        # steps below 2 / that bound are certainly stable and need no eigenvalue computation
+        # (L.lam_max computes it on first use). With a negative (obtuse) cotangent weight the
+        # row's |C_ij| add up to more than |C_ii|: the shorter max 2 |C_ii| / M_ii is then no bound.
+        # The sums run over every column: with a fixed boundary they bound the interior block's rows too.
+        radius = abs(L.C[L.moving]).sum(axis=1).A1  # |C_ii| + sum_{j != i} |C_ij|
+        if tau > 0 and L.moving.any() and tau * np.max(radius / L.m[L.moving]) > 2.0:
             limit = 2.0 / L.lam_max if L.lam_max > 0 else float("inf")
             if tau > limit * (1 + 1e-12):
                 warnings.warn(
@@ -590,9 +593,9 @@ def implicit_smoothing(
     rebuild : bool
         False (default): the operator of V is kept and factorised once. True: M
         and C are rebuilt from the current positions every iteration (implicit
-        mean curvature flow); as the surface shrinks triangles degenerate and
-        the mesh can collapse: then the run stops (see ``on_failure``) instead
-        of returning a NaN mesh.
+        mean curvature flow); as the surface shrinks its area goes to zero (a
+        non-convex one may pinch off first) and triangles degenerate: then the
+        run stops (see ``on_failure``) instead of returning a NaN mesh.
     keep_volume : bool
         After every iteration rescale about the centroid of the enclosed solid
         so that volume and centroid stay those of V (the volume rescaling of

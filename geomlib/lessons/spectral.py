@@ -13,9 +13,10 @@ components has ``c`` zero eigenvalues, one per component, and their
 eigenvectors are the normalised indicator functions of the components
 (largest area first); each component then has its own spectrum.
 
-How it is solved (:func:`eigenbasis`, which solves on every call): ``M^-1 C``
-is not symmetric, so with ``D = M^1/2`` the problem becomes ``Q y = lam y``,
-``Q = -D^-1 C D^-1``, ``e = D^-1 y`` (Vallet and Levy 2008), handed to
+How it is solved (:func:`eigenbasis`, which solves on every call, builds
+``(M, C)`` and hands them to :func:`eigenpairs`, the solve for a given pair): ``M^-1 C``
+is not symmetric, so with ``D = M^1/2`` the problem becomes ``Q z = lam z``,
+``Q = -D^-1 C D^-1``, ``e = D^-1 z`` (Vallet and Levy 2008), handed to
 :func:`geomlib.numerics.eigen.smallest_eigenpairs` (dense LAPACK for small
 meshes, block Lanczos on one sparse Cholesky factorisation otherwise).
 
@@ -32,10 +33,10 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse import csgraph
 
 from ..mesh.errors import MeshError, MeshWarning
 from ..mesh.requirements import positive_vertex_areas
-from ..mesh.topology import connected_components
 from ..mesh.validate import as_mesh
 from ..numerics import cache as basis_cache
 from ..numerics.eigen import one_blas_thread, smallest_eigenpairs
@@ -43,6 +44,7 @@ from .laplace import laplacian, uniform_laplacian, vertex_areas
 
 __all__ = [
     "eigenbasis",
+    "eigenpairs",
     "spectral_reconstruction",
     "SpectralBasis",
     "spectral_basis",
@@ -57,11 +59,12 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
     """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
 
     ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
-    Solved in the symmetric form ``Q y = lam y`` with ``Q = -M^-1/2 C M^-1/2``
-    and ``e = M^-1/2 y`` (Vallet and Levy 2008): dense LAPACK for small meshes,
+    Solved in the symmetric form ``Q z = lam z`` with ``Q = -M^-1/2 C M^-1/2``
+    and ``e = M^-1/2 z`` (Vallet and Levy 2008): dense LAPACK for small meshes,
     block Lanczos on the inverse of ``Q + shift I``, applied by one sparse
-    Cholesky factorisation, otherwise (:mod:`geomlib.numerics.eigen`). Every
-    call solves; :func:`spectral_basis` keeps the result in a cache.
+    Cholesky factorisation, otherwise (:mod:`geomlib.numerics.eigen`); the
+    solve for the pair is :func:`eigenpairs`. Every call solves;
+    :func:`spectral_basis` keeps the result in a cache.
 
     Parameters
     ----------
@@ -75,7 +78,7 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
         when k is more than a third of n, "sparse" otherwise; "arpack" is
         another name for "sparse" (kept for old calls).
     tol : float
-        Relative residual of the sparse solve, ``||Q y - lam y|| <= tol ||Q||``
+        Relative residual of the sparse solve, ``||Q z - lam z|| <= tol ||Q||``
         (:func:`geomlib.numerics.eigen.smallest_eigenpairs`).
 
     Returns
@@ -112,14 +115,58 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
     V, F = as_mesh(V, F)
     k, method = _check_k(k, len(V)), _check_method(method)
     M, C = laplacian(V, F, weights=weights, area=area)
-    m = positive_vertex_areas(M, F, "eigenbasis")
+    positive_vertex_areas(M, F, "eigenbasis")  # names the vertices without area, and the call that removes them
+    return eigenpairs(M, C, k, method=method, tol=tol)
+
+
+def eigenpairs(M, C, k, *, method="auto", tol=1e-10):
+    """The k smallest eigenpairs of ``C e = -lam M e`` for a given pair (M, C): ``lam`` ascending >= 0, ``E^T M E = I``.
+
+    The solve behind :func:`eigenbasis`, for any pair with the signs of
+    :func:`geomlib.laplacian`: ``C`` (n, n) symmetric negative semidefinite
+    with rows summing to zero, ``M`` (n, n) diagonal and positive. Solved in the
+    symmetric form ``Q z = lam z``, ``Q = -M^-1/2 C M^-1/2``, ``e = M^-1/2 z``
+    (Vallet and Levy 2008). The null space is known before the solve: on each
+    connected piece of the graph of C (the mesh's components), the constant.
+
+    Parameters
+    ----------
+    M : (n, n) scipy.sparse or array, diagonal, positive (length^2 for the cotangent pair)
+    C : (n, n) scipy.sparse or array, symmetric, negative semidefinite
+    k : int, 1 <= k <= n
+    method, tol : as in :func:`eigenbasis`.
+
+    Returns
+    -------
+    lam : (k,) float64, ascending, ``lam[0] == 0``; E : (n, k) float64, ``E^T M E = I``
+        (see :func:`eigenbasis` for the null space, signs and repeated eigenvalues).
+
+    Raises
+    ------
+    MeshError
+        M or C not (n, n), M not diagonal or with an entry <= 0, k outside 1..n, unknown method.
+    """
+    M, C = _square_pair(M, C)
+    m = positive_vertex_areas(M, None, "eigenpairs")
+    k, method = _check_k(k, len(m)), _check_method(method)
     D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
-    Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q y = lam y (notebook 04's symbol)
+    Q = D_inv @ (-C) @ D_inv  # symmetric PSD: Q z = lam z (notebook 04's symbol)
     shift = 1e-4 * 4.0 * np.pi / m.sum()  # far below lam_1 (Weyl: about 4 pi / area)
-    Y0 = null_vectors(F, m)  # Q (sqrt(A_i) on one component, 0 elsewhere) = 0: known, kept out of the solve
-    lam, Y = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol, null=Y0)
-    E = D_inv @ Y  # e = M^-1/2 y, so E^T M E = Y^T Y = I
-    return _tidy(lam, E, m, F)
+    count, labels = _components(C, m)
+    Z0 = null_vectors(labels, count, m)  # Q (sqrt(A_i) on one component, 0 elsewhere) = 0: known, kept out of the solve
+    lam, Z = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol, null=Z0)
+    E = D_inv @ Z  # e = M^-1/2 z, so E^T M E = Z^T Z = I
+    return _tidy(lam, E, m, count, labels)
+
+
+def _square_pair(M, C):
+    M, C = sp.csr_matrix(M), sp.csr_matrix(C)
+    n = M.shape[0]
+    if M.shape != (n, n) or C.shape != (n, n):
+        raise MeshError(f"M and C must be square and of one size: M is {M.shape}, C is {C.shape}")
+    if abs(M - sp.diags(M.diagonal())).max() > 0:
+        raise MeshError("M must be diagonal (the lumped vertex areas): its off-diagonal entries are not all zero")
+    return M, C
 
 
 def _check_k(k, n):
@@ -141,41 +188,42 @@ def _check_method(method):
     return method
 
 
-def _components(F, m):
-    """Component label per vertex, numbered by area, largest first (ties: smallest vertex index)."""
-    labels = connected_components(F, len(m))
-    count = labels.max() + 1
+def _components(C, m):
+    """(count, label per vertex) of the pieces the graph of C links, numbered by area, largest first.
+
+    The graph of C is the mesh's edges, so its pieces are the mesh's connected
+    components; ties in area go to the piece with the smallest vertex index.
+    """
+    count, labels = csgraph.connected_components(C, directed=False)  # numbered by their smallest vertex
     size = np.bincount(labels, weights=m, minlength=count)
     rank = np.empty(count, dtype=np.int64)
-    rank[np.lexsort((np.arange(count), -size))] = np.arange(count)  # labels follow the first vertex
+    rank[np.lexsort((np.arange(count), -size))] = np.arange(count)
     return count, rank[labels]
 
 
-def null_vectors(F, m):
-    """Orthonormal (n, c) eigenvectors of ``Q = -M^-1/2 C M^-1/2`` for ``lam = 0``, one per connected component.
+def null_vectors(labels, count, m):
+    """Orthonormal (n, count) eigenvectors of ``Q = -M^-1/2 C M^-1/2`` for ``lam = 0``, one per connected component.
 
-    Column c is ``sqrt(m)`` on the vertices of component c (numbered by area,
-    largest first, as :func:`eigenbasis` orders them) and 0 elsewhere,
+    Column c is ``sqrt(m)`` on the vertices with label c (components numbered by
+    area, largest first, as :func:`eigenbasis` orders them) and 0 elsewhere,
     normalised: ``Q`` maps it to 0 because every row of C sums to 0.
     """
-    count, labels = _components(F, m)
-    Y0 = (labels[:, None] == np.arange(count)[None, :]) * np.sqrt(m)[:, None]
-    return Y0 / np.linalg.norm(Y0, axis=0)
+    Z0 = (labels[:, None] == np.arange(count)[None, :]) * np.sqrt(m)[:, None]
+    return Z0 / np.linalg.norm(Z0, axis=0)
 
 
-def _tidy(lam, E, m, F):
+def _tidy(lam, E, m, count, labels):
     """Exact zeros and indicator functions for the null space, M-normalised columns, fixed signs."""
     lam = np.array(lam, dtype=np.float64)
     E = np.asfortranarray(E)
-    E /= np.sqrt(np.einsum("ij,i,ij->j", E, m, E))[None, :]  # Y^T Y = I only to rounding
-    count, labels = _components(F, m)
+    E /= np.sqrt(np.einsum("ij,i,ij->j", E, m, E))[None, :]  # Z^T Z = I only to rounding
     if count > 1:
         warnings.warn(
             f"the mesh has {count} connected components: the first {count} eigenvalues are 0 "
             f"and their eigenvectors are the components' indicator functions; each component "
             f"has its own spectrum",
             MeshWarning,
-            stacklevel=3,
+            stacklevel=4,  # _tidy <- eigenpairs <- eigenbasis <- the caller
         )
     c = min(count, len(lam))
     # The solver returns some rotation of the null space (rounding decides which):

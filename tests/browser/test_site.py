@@ -29,13 +29,17 @@ cell's 3D view and read-out, and moved back restores the first picture exactly.
 
 The index lists every notebook in reading order, and a page opened from
 ``file://`` works the same way (canvases drawn, nothing fetched from outside).
+
+The site as a whole (no browser needed, on the same build): a page for every notebook
+(core and appendix), every markdown page (README, docs/) and the reference; previous/next
+links between neighbours in reading order, both ways; every relative link and picture of
+every page leads to a file of the site (a notebook's ``.ipynb`` link became its ``.html``);
+the reference lists every public name of geomlib; the folder within 60 MB.
 Screenshots: build/screenshots/site/.
 """
 
 import functools
 import http.server
-import json
-import os
 import re
 import sys
 import threading
@@ -50,7 +54,8 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 import build_site  # noqa: E402
 
-NOTEBOOKS = sorted(p.name for p in build_site.NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+NOTEBOOKS = [p.name for p in build_site.notebook_paths()]  # core and appendix, in reading order
+SITE_BYTES = 60_000_000  # the whole folder (issue 30)
 SCREENSHOTS = ROOT / "build" / "screenshots" / "site"
 LOAD_TIMEOUT = 90  # seconds for a page's views and formulas to appear
 LOCAL_SCHEMES = ("file:", "data:", "blob:")
@@ -65,19 +70,6 @@ LIVE_SLIDERS = {
     "06_implicit_smoothing.html": {"τ / ℓ²", "iterations"},
     "07_denoising_evaluation.html": {"sigma", "iterations"},
 }
-
-
-@pytest.fixture(scope="session")
-def site(browser, tmp_path_factory):
-    given = os.environ.get("GEOMLIB_SITE_DIR")
-    if given:
-        folder = Path(given)
-        assert (folder / "pages.json").exists(), f"GEOMLIB_SITE_DIR={given} holds no built site"
-    else:
-        folder = tmp_path_factory.mktemp("site")
-        build_site.build(folder)
-    pages = {p["file"]: p for p in json.loads((folder / "pages.json").read_text())}
-    return folder, pages
 
 
 @pytest.fixture(scope="session")
@@ -423,3 +415,70 @@ def test_precomputed_sliders_move_the_views(name, site, site_url, browser):
         assert not view.errors, "console errors:\n" + "\n".join(view.errors)
     finally:
         view.close()
+
+
+# ---------------------------------------------------------------------------
+# the site as a whole: pages, reading order, links, reference, size
+# ---------------------------------------------------------------------------
+
+NAV = re.compile(r'<nav[^>]*class="site-nav[^"]*"[^>]*>(.*?)</nav>', re.S)
+HREF = re.compile(r'(?:href|src)="([^"]*)"')
+
+
+def _order():
+    """The page files the site must have, in reading order."""
+    docs = list(build_site.doc_pages().values())
+    return [Path(n).stem + ".html" for n in NOTEBOOKS] + docs + [build_site.REFERENCE]
+
+
+def test_a_page_for_every_notebook_docs_page_and_the_reference(site):
+    folder, pages = site
+    assert list(pages) == _order()
+    assert [p for p in _order() if not (folder / p).is_file()] == []
+
+
+def test_previous_and_next_link_neighbours_both_ways(site):
+    folder, _ = site
+    order = _order()
+    for i, name in enumerate(order):
+        navs = NAV.findall((folder / name).read_text(encoding="utf-8"))
+        assert len(navs) == 2, f"{name}: {len(navs)} navigation bars, not one above and one below"
+        for nav in navs:
+            links = HREF.findall(nav)
+            want = [order[j] for j in (i - 1, i + 1) if 0 <= j < len(order)]
+            assert "index.html" in links and all(w in links for w in want), f"{name}: {links}, wanted {want}"
+            assert set(links) <= {"index.html", *want}, f"{name}: {links}"
+
+
+def test_every_link_of_every_page_leads_into_the_site(site):
+    folder, _ = site
+    for page in sorted(folder.glob("*.html")):
+        text = page.read_text(encoding="utf-8")
+        broken = set()
+        for target in HREF.findall(text):
+            if not target or re.match(r"^([a-z][a-z0-9+.-]*:|#|//)", target):
+                continue
+            path = target.partition("#")[0].partition("?")[0]
+            if path and not (folder / path).is_file():
+                broken.add(target)
+        assert not broken, f"{page.name} links to files the site does not have: {sorted(broken)[:5]}"
+        assert not re.search(r'href="[^"#:]*\.(ipynb|md)(#[^"]*)?"', text), f"{page.name} links to a notebook or .md"
+
+
+def test_the_reference_lists_every_public_name(site):
+    folder, _ = site
+    import geomlib
+
+    text = (folder / build_site.REFERENCE).read_text(encoding="utf-8")
+    missing = [name for name in geomlib.__all__ if f'id="{name}"' not in text]
+    assert not missing, f"the reference has no entry for {missing}"
+    assert "<html lang=" in text and not re.search(r'(?:src|href)="(?:https?:)?//[^"]*\.(js|css)', text)
+
+
+def test_the_site_stays_within_60_mb(site):
+    folder, pages = site
+    size = build_site.folder_size(folder)
+    biggest = sorted(pages.values(), key=lambda p: -p.get("bytes", 0))[:3]
+    assert size <= SITE_BYTES, f"the site is {size / 1e6:.1f} MB; largest pages: " + ", ".join(
+        f"{p['file']} {p['bytes'] / 1e6:.1f} MB" for p in biggest
+    )

@@ -1,17 +1,22 @@
 """Checks of the exercises of notebook 03 (the cotangent Laplacian and the vertex areas).
 
 The small cases have known answers: an irregular tetrahedron (closed, every
-angle different, none right), one obtuse triangle (mixed areas A/2, A/4, A/4)
-and a jittered 4 x 4 grid (open, with obtuse triangles and boundary edges).
-The reference values come from ``geomlib.lessons.laplace``; the typical wrong
-variants are rebuilt here from the per-corner cotangents
+angle different, none right), an irregular triangular bipyramid (closed, valences
+3 and 4, three obtuse triangles), one obtuse triangle (mixed areas A/2, A/4, A/4)
+and a jittered 4 x 4 grid (open, valences 1 to 6, obtuse triangles and boundary
+edges). The reference values come from ``geomlib.lessons.laplace``; the typical
+wrong variants are rebuilt here from the per-corner cotangents
 (``geomlib.lessons.laplace.face_geometry``) so each can be named when it is met.
+Vertex-area mistakes are named by ``geomlib.teaching.check.areas``, in the same
+words as the Gaussian-curvature check of notebook 01.
 """
 
 import numpy as np
 
 from ...lessons import laplace
-from ...lessons.laplace import face_geometry, laplacian
+from ...lessons.laplace import barycentric_areas, cotangent_matrix, face_geometry
+from ...mesh.topology import boundary_edges
+from .areas import area_mistake_over
 from .result import Mistake, call, close, exercise, matrix_pair, vector
 
 __all__ = ["cotangent_laplacian", "vertex_areas", "mixed_areas"]
@@ -21,6 +26,8 @@ _REREAD_A = "section 2 · Which area? Barycentric and mixed Voronoi"
 
 _TET_V = np.array([[0.0, 0.0, 0.0], [1.3, 0.1, 0.0], [0.4, 1.1, 0.2], [0.3, 0.4, 0.9]])
 _TET_F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+_BIPYRAMID_V = np.array([[0.0, 0, 0], [2.2, 0.1, 0], [0.5, 1.2, 0.1], [0.9, 0.45, 0.3], [0.7, 0.5, -0.8]])
+_BIPYRAMID_F = np.array([[0, 1, 3], [1, 2, 3], [2, 0, 3], [1, 0, 4], [2, 1, 4], [0, 2, 4]])
 _OBTUSE_V = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [1.0, 1.0, 0.0]])  # obtuse at vertex 2, area 2
 _OBTUSE_F = np.array([[0, 1, 2]])
 
@@ -38,7 +45,12 @@ def _jittered_grid():
 
 
 _GRID_V, _GRID_F = _jittered_grid()
-_CASES = (("an irregular tetrahedron", _TET_V, _TET_F), ("a jittered 4 x 4 grid", _GRID_V, _GRID_F))
+_CASES = (
+    ("an irregular tetrahedron", _TET_V, _TET_F),
+    ("an irregular bipyramid", _BIPYRAMID_V, _BIPYRAMID_F),
+    ("a jittered 4 x 4 grid", _GRID_V, _GRID_F),
+)
+_AREA_CASES = (("one obtuse triangle", _OBTUSE_V, _OBTUSE_F),) + _CASES
 
 
 def _weights(V, F, corner, of=lambda cot: cot):
@@ -64,6 +76,99 @@ def _wrong_angle_variants(V, F):
     ]
 
 
+def _with_diagonal(W):
+    """W with its diagonal replaced so that its rows sum to zero."""
+    off = W - np.diag(np.diag(W))
+    return off - np.diag(off.sum(axis=1))
+
+
+def _boundary_variants(V, F, C_ref):
+    """[(C, diagnosis, hint)]: the ways a learner's boundary rule departs from the natural one."""
+    E = boundary_edges(F)
+    on = np.zeros(len(V), bool)
+    on[E.ravel()] = True
+    rows = np.where(on[:, None], 0.0, C_ref)
+    interior_only = C_ref.copy()
+    interior_only[E[:, 0], E[:, 1]] = interior_only[E[:, 1], E[:, 0]] = 0.0
+    doubled = C_ref.copy()
+    doubled[E[:, 0], E[:, 1]] *= 2
+    doubled[E[:, 1], E[:, 0]] *= 2
+    natural = (
+        "this exercise asks for the operator itself, with the natural boundary: a boundary edge has one "
+        "triangle and gets 1/2 cot of its one opposite angle, and a boundary vertex keeps its row"
+    )
+    return [
+        (rows, "the rows of the boundary vertices are zeroed: a boundary rule (fixed boundary) built into C", natural),
+        (
+            np.where(on[:, None] | on[None, :], 0.0, C_ref),
+            "the rows and columns of the boundary vertices are zeroed: a boundary rule built into C",
+            natural,
+        ),
+        (
+            _with_diagonal(interior_only),
+            "boundary edges are left out: an edge with one triangle gets no weight",
+            "a boundary edge gets 1/2 cot of the one angle opposite it",
+        ),
+        (
+            _with_diagonal(doubled),
+            "boundary edges get cot of their one opposite angle, without the 1/2",
+            "C_ij = 1/2 (cot alpha_ij + cot beta_ij); a boundary edge has only alpha_ij: 1/2 cot alpha_ij",
+        ),
+    ]
+
+
+def _check_cotangent_C(C, C_ref, V, F, label):
+    off = ~np.eye(len(V), dtype=bool)
+    if close(C, -C_ref):
+        raise Mistake(
+            "the sign of C is flipped",
+            "C_ij = +(cot alpha_ij + cot beta_ij) / 2 off the diagonal, so that C is negative "
+            "semidefinite and Delta x = -2 H n",
+        )
+    if close(C, 2 * C_ref) or close(C[off], 2 * C_ref[off]):
+        raise Mistake(
+            "the factor 1/2 is missing (every weight is twice the right one)",
+            "C_ij = 1/2 (cot alpha_ij + cot beta_ij)",
+        )
+    if close(C[off], C_ref[off]) and np.allclose(np.diag(C), 0):
+        raise Mistake(
+            "the diagonal of C is missing (its rows do not sum to zero)",
+            "set C_ii = -sum of C_ij over the neighbours j of i",
+        )
+    if any(close(C[off], W[off]) for W in _wrong_angle_variants(V, F)):
+        raise Mistake(
+            "the cotangent of the wrong angle is used: an angle at i or j, an end of the edge ij",
+            "use the two angles opposite the edge ij, at the third corner of each triangle",
+        )
+    for A in (barycentric_areas(V, F), laplace.mixed_areas(V, F)):
+        if close(C, C_ref / A[:, None]):
+            raise Mistake(
+                "C is already divided by the vertex areas: that is M^-1 C (the operator Delta), not C",
+                "keep C_ij = 1/2 (cot alpha_ij + cot beta_ij) and put the areas in M",
+            )
+    uniform = (C_ref != 0).astype(float)
+    if close(C[off], uniform[off]):
+        raise Mistake(
+            "these are the uniform weights (1 for every edge), not the cotangent weights",
+            "C_ij = 1/2 (cot alpha_ij + cot beta_ij), from the two angles opposite the edge ij",
+        )
+    tan = _weights(V, F, lambda p, q, r: r, of=lambda cot: 1.0 / cot)
+    if close(C[off], tan[off]) or close(C[off], -tan[off]):
+        raise Mistake("tan is used instead of cot", "cot theta = cos theta / sin theta = 1 / tan theta")
+    for wrong, diagnosis, hint in _boundary_variants(V, F, C_ref):
+        if not close(wrong, C_ref) and (close(C, wrong) or close(C[off], wrong[off])):
+            raise Mistake(diagnosis, hint)
+    if not close(C, C.T):
+        raise Mistake("C is not symmetric", "add each triangle's weight to both C_ij and C_ji")
+    if not close(C, C_ref):
+        raise Mistake(
+            f"C differs from the cotangent Laplacian on {label}",
+            "each triangle (i, j, k) adds cot(angle at k) / 2 to C_ij and C_ji, and subtracts the "
+            "same from C_ii and C_jj",
+            typical=False,
+        )
+
+
 @exercise(
     "cotangent_laplacian",
     reread=_REREAD_C,
@@ -77,81 +182,54 @@ def _wrong_angle_variants(V, F):
 )
 def cotangent_laplacian(fn):
     """Check ``fn(V, F) -> (M, C)``: C_ij = (cot alpha_ij + cot beta_ij) / 2, C_ii = -sum_j C_ij, M barycentric."""
-    checked = []
+    found = []
     for label, V, F in _CASES:
         M, C = matrix_pair(call(fn, V.copy(), F.copy()), n=len(V))
-        M_ref, C_ref = (A.toarray() for A in laplacian(V, F, weights="cotan", area="barycentric"))
-        off = ~np.eye(len(V), dtype=bool)
-        tan = _weights(V, F, lambda p, q, r: r, of=lambda cot: 1.0 / cot)
-        if close(C, -C_ref):
-            raise Mistake(
-                "the sign of C is flipped",
-                "C_ij = +(cot alpha_ij + cot beta_ij) / 2 off the diagonal, so that C is negative "
-                "semidefinite and Delta x = -2 H n",
-            )
-        if close(C, 2 * C_ref) or close(C[off], 2 * C_ref[off]):
-            raise Mistake(
-                "the factor 1/2 is missing (every weight is twice the right one)",
-                "C_ij = 1/2 (cot alpha_ij + cot beta_ij)",
-            )
-        if close(C[off], C_ref[off]) and np.allclose(np.diag(C), 0):
-            raise Mistake(
-                "the diagonal of C is missing (its rows do not sum to zero)",
-                "set C_ii = -sum of C_ij over the neighbours j of i",
-            )
-        if any(close(C[off], W[off]) for W in _wrong_angle_variants(V, F)):
-            raise Mistake(
-                "the cotangent of the wrong angle is used: an angle at i or j, an end of the edge ij",
-                "use the two angles opposite the edge ij, at the third corner of each triangle",
-            )
-        if close(C[off], tan[off]) or close(C[off], -tan[off]):
-            raise Mistake("tan is used instead of cot", "cot theta = cos theta / sin theta = 1 / tan theta")
-        if not close(C, C.T):
-            raise Mistake("C is not symmetric", "add each triangle's weight to both C_ij and C_ji")
-        if not close(C, C_ref):
-            raise Mistake(
-                f"C differs from the cotangent Laplacian on {label}",
-                "each triangle (i, j, k) adds cot(angle at k) / 2 to C_ij and C_ji, and subtracts the "
-                "same from C_ii and C_jj",
-                typical=False,
-            )
+        _check_cotangent_C(C, cotangent_matrix(V, F).toarray(), V, F, label)
+        found.append((label, V, F, M))
+    for label, V, F, M in found:
         if close(M, np.eye(len(V))):
             raise Mistake("M is the identity", "M = diag(A_i), a third of the areas of the triangles around i")
-        _check_area_scale(M, M_ref, "M")
-        if np.count_nonzero(M[off]):
+        if np.count_nonzero(M[~np.eye(len(V), dtype=bool)]):
             raise Mistake("M is not diagonal", "M = diag(A_i): the lumped (diagonal) mass matrix")
-        if not close(M, M_ref):
+    mistake = area_mistake_over([(np.diag(M), V, F) for _, V, F, M in found], "barycentric")
+    if mistake:
+        raise Mistake(f"the areas on the diagonal of M are wrong: {mistake[0]}", mistake[1])
+    for label, V, F, M in found:
+        if not close(np.diag(M), barycentric_areas(V, F)):
             raise Mistake(
                 f"M differs from the barycentric areas on {label}",
                 "M_ii = 1/3 of the sum of the areas of the triangles around i",
                 typical=False,
             )
-        checked.append(label)
-    return checked
+    return [label for label, *_ in found]
 
 
-def _check_area_scale(A, ref, what):
-    """The two scale mistakes of barycentric areas (A or M against the reference ``ref``)."""
-    if close(A, 3 * ref):
-        raise Mistake(
-            f"{what} is not divided by 3: each vertex gets the whole area of its triangles",
-            "a triangle gives a third of its area to each of its corners",
-        )
-    if close(A, 2 * ref) or close(A, 6 * ref):
-        raise Mistake(
-            f"{what} uses twice the triangle area (the length of the cross product is 2 A)",
-            "a triangle's area is |(x_j - x_i) x (x_k - x_i)| / 2",
-        )
-
-
-def _areas(fn, V, F, what):
+def _areas(fn, V, F):
     out = call(fn, V.copy(), F.copy())
     if np.ndim(out) == 1 and len(out) == len(F) != len(V):
         raise Mistake(
-            f"{what} returned one value per face ({len(F)}), not one per vertex ({len(V)})",
+            f"the function returned one value per face ({len(F)}), not one per vertex ({len(V)})",
             "accumulate each face's share into its three vertices, e.g. with np.add.at or np.bincount",
         )
-    return vector(out, len(V), what)
+    return vector(out, len(V), "the function")
+
+
+def _check_areas(fn, asked, reference, hint):
+    """Run ``fn`` on every case; name the area mistake it makes on all of them, or where it differs."""
+    found = [(label, _areas(fn, V, F), V, F) for label, V, F in _AREA_CASES]
+    mistake = area_mistake_over([(A, V, F) for _, A, V, F in found], asked)
+    if mistake:
+        raise Mistake(*mistake)
+    for label, A, V, F in found:
+        ref = reference(V, F)
+        if not close(A, ref):
+            raise Mistake(
+                f"the areas differ from the {asked} areas on {label} (sum {A.sum():.6g}, surface area {ref.sum():.6g})",
+                hint,
+                typical=False,
+            )
+    return [label for label, *_ in found]
 
 
 @exercise(
@@ -166,41 +244,9 @@ def _areas(fn, V, F, what):
 )
 def vertex_areas(fn):
     """Check ``fn(V, F) -> (n,)`` barycentric vertex areas: A_i = 1/3 of the incident triangle areas."""
-    checked = []
-    for label, V, F in (("one obtuse triangle", _OBTUSE_V, _OBTUSE_F),) + _CASES:
-        A = _areas(fn, V, F, "the function")
-        ref = laplace.vertex_areas(V, F, "barycentric")
-        _check_area_scale(A, ref, "the area")
-        if label == "one obtuse triangle" and close(A, laplace.vertex_areas(V, F, "mixed")):
-            raise Mistake(
-                "these are the mixed (Voronoi) areas, not the barycentric ones",
-                "the barycentric area gives every corner the same third",
-            )
-        if not close(A, ref):
-            raise Mistake(
-                f"the areas differ from the barycentric areas on {label} "
-                f"(sum {A.sum():.6g}, surface area {ref.sum():.6g})",
-                "A_i = 1/3 of the sum of the areas of the triangles around i",
-                typical=False,
-            )
-        checked.append(label)
-    return checked
-
-
-def _voronoi_pieces(V, F):
-    """Per-corner Voronoi areas 1/8 (l_j^2 cot_j + l_k^2 cot_k), negative where the circumcentre is outside."""
-    l2, _, cot, _ = face_geometry(V, F)
-    lc = l2 * cot
-    return np.stack([lc[:, 1] + lc[:, 2], lc[:, 2] + lc[:, 0], lc[:, 0] + lc[:, 1]], axis=1) / 8
-
-
-def _is(A, variant, ref):
-    """A equals a wrong variant that differs from the reference on this case."""
-    return close(A, variant) and not close(variant, ref)
-
-
-def _per_corner_sum(n, F, pieces):
-    return np.bincount(F.ravel(), weights=pieces.ravel(), minlength=n)
+    return _check_areas(
+        fn, "barycentric", barycentric_areas, "A_i = 1/3 of the sum of the areas of the triangles around i"
+    )
 
 
 @exercise(
@@ -215,49 +261,10 @@ def _per_corner_sum(n, F, pieces):
 )
 def mixed_areas(fn):
     """Check ``fn(V, F) -> (n,)`` mixed areas (Meyer et al. 2003): Voronoi, or A/2 and A/4 in obtuse triangles."""
-    checked = []
-    for label, V, F in (("one obtuse triangle", _OBTUSE_V, _OBTUSE_F),) + _CASES:
-        A = _areas(fn, V, F, "the function")
-        ref = laplace.vertex_areas(V, F, "mixed")
-        _, dblA, cot, _ = face_geometry(V, F)
-        Af = (dblA / 2)[:, None]
-        obtuse_corner, obtuse_face = cot < 0, (cot < 0).any(axis=1, keepdims=True)
-        voronoi = _voronoi_pieces(V, F)
-        swapped = np.where(obtuse_face, np.where(obtuse_corner, Af / 4, Af / 2), voronoi)
-        only_at_obtuse = np.where(obtuse_corner, Af / 2, voronoi)
-        if _is(A, _per_corner_sum(len(V), F, voronoi), ref):
-            raise Mistake(
-                "the obtuse rule is missing: these are the plain Voronoi areas, negative at corners "
-                "of obtuse triangles",
-                "in an obtuse triangle give A_f/2 to the obtuse corner and A_f/4 to the other two",
-            )
-        if _is(A, laplace.vertex_areas(V, F, "barycentric"), ref):
-            raise Mistake(
-                "these are the barycentric areas (a third of each triangle), not the mixed ones",
-                "use the Voronoi piece 1/8 (|e_ij|^2 cot + |e_ik|^2 cot) in non-obtuse triangles",
-            )
-        if _is(A, _per_corner_sum(len(V), F, swapped), ref):
-            raise Mistake(
-                "the halves are swapped in obtuse triangles: the obtuse corner gets A_f/4",
-                "the obtuse corner gets A_f/2, the two acute corners A_f/4 each",
-            )
-        if _is(A, _per_corner_sum(len(V), F, only_at_obtuse), ref):
-            raise Mistake(
-                "the obtuse rule is applied only at the obtuse corner; the other two corners of an "
-                "obtuse triangle still get their Voronoi pieces",
-                "in an obtuse triangle the two acute corners get A_f/4 each",
-            )
-        if close(A, 3 * ref) or close(A, 2 * ref):
-            raise Mistake(
-                "the areas are a whole multiple of the right ones",
-                "check the factors: 1/8 in the Voronoi piece, A_f = |cross| / 2",
-            )
-        if not close(A, ref):
-            raise Mistake(
-                f"the areas differ from the mixed areas on {label} (sum {A.sum():.6g}, surface area {ref.sum():.6g})",
-                "non-obtuse triangle: 1/8 (|e_ij|^2 cot(angle at k) + |e_ik|^2 cot(angle at j)); "
-                "obtuse: A_f/2 at the obtuse corner, A_f/4 at the others",
-                typical=False,
-            )
-        checked.append(label)
-    return checked
+    return _check_areas(
+        fn,
+        "mixed",
+        laplace.mixed_areas,
+        "non-obtuse triangle: 1/8 (|e_ij|^2 cot(angle at k) + |e_ik|^2 cot(angle at j)); "
+        "obtuse: A_f/2 at the obtuse corner, A_f/4 at the others",
+    )

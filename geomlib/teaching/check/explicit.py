@@ -7,15 +7,17 @@ P' = P + tau M^-1 C P, stable for tau < 2 / lam_max.
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sp
 
 from ...lessons.laplace import laplacian
 from .. import surfaces
 from .result import Mistake, call, close, exercise
 
-__all__ = ["explicit_step", "explicit_step_limit"]
+__all__ = ["explicit_step", "explicit_step_limit", "smoothing_loop"]
 
-_REREAD_STEP = "section 2 · Discretised in space and time"
-_REREAD_LIMIT = "section 3 · Why the step has a limit"
+_REREAD_STEP = "section 1 · The heat flow, one explicit step at a time"
+_REREAD_LIMIT = "section 2 · Why the step has a limit"
+_REREAD_LOOP = "section 3 · The smoothing loop, boundary held"
 
 # a tetrahedron with unequal faces (so M is not a multiple of I) and a small
 # ellipsoid scaled by 3 (so the eigenvalues of C and of M^-1 C differ by far)
@@ -94,6 +96,7 @@ def explicit_step(fn):
                 )
             if close(out, P + (C @ P) / m):
                 raise Mistake("the step tau is missing", "scale the Laplacian by tau: P + tau M^-1 C P")
+            _uniform_step(out, P, C, tau)
             if close(out, P + tau * (C @ (P / m))):
                 raise Mistake(
                     "the areas divide P before C is applied (C M^-1 P), not after (M^-1 C P)",
@@ -107,6 +110,28 @@ def explicit_step(fn):
             )
         checked.append(label)
     return checked
+
+
+def _uniform_step(out, P, C, tau):
+    """Raise the Mistake of a uniform step (neighbour averaging) written for the cotangent C it was given."""
+    c = -C.diagonal()[:, None]  # |C_ii|: the valence for uniform weights, a sum of cotangents here
+    A = sp.csr_matrix(C, copy=True)
+    A.setdiag(0)
+    A.eliminate_zeros()
+    A.data[:] = 1.0  # the neighbours, every weight 1
+    valence = np.asarray(A.sum(axis=1))
+    if close(out, P + tau * (C @ P) / c):
+        raise Mistake(
+            "the step divides C P by |C_ii|, which is the valence M_ii only for the uniform operator; "
+            "C here holds cotangent weights, and its M holds vertex areas",
+            "divide by the M you are given: P + tau (C P) / M_ii",
+        )
+    if close(out, P + tau * (A @ P / valence - P)) or close(out, P + tau * (C @ P) / valence):
+        raise Mistake(
+            "this is the uniform step (every neighbour weighs 1, divided by the valence) given a cotangent C: "
+            "the weights C_ij and the vertex areas M_ii are not used",
+            "use the matrices you are given: P + tau M^-1 C P",
+        )
 
 
 def _lam(A, M):
@@ -180,3 +205,143 @@ def explicit_step_limit(fn):
             typical=False,
         )
     return checked
+
+
+def loop_case():
+    """An open, noisy 6 x 6 grid (20 boundary vertices) whose in-plane jitter gives the cotangent
+    operator a shape of its own, so that a rebuilt operator, the uniform one and a moving boundary
+    all end up elsewhere."""
+    rng = np.random.default_rng(29)
+    u, v = np.meshgrid(np.linspace(0.0, 1.0, 6), np.linspace(0.0, 1.0, 6), indexing="ij")
+    V = np.column_stack([u.ravel(), v.ravel(), 0.06 * rng.standard_normal(36)])
+    V[:, :2] += 0.04 * rng.uniform(-1, 1, (36, 2))
+    q = np.arange(36).reshape(6, 6)[:-1, :-1].ravel()
+    F = np.concatenate([np.column_stack([q, q + 6, q + 7]), np.column_stack([q, q + 7, q + 1])])
+    return V, F
+
+
+def _smoothed(V, F, tau, iterations, weights="cotan", rebuild=False, fixed=None, areas=True):
+    """``iterations`` explicit steps, the rows of ``fixed`` held; M and C of V, or of every iterate
+    (``areas=False``: C P not divided by the vertex areas)."""
+    P = V.copy()
+    moving = np.ones(len(V), dtype=bool) if fixed is None else ~fixed
+    M, C = laplacian(V, F, weights=weights)
+    for _ in range(iterations):
+        if rebuild:
+            M, C = laplacian(P, F, weights=weights)
+        m = M.diagonal()[:, None] if areas else 1.0
+        P = P + tau * moving[:, None] * (C @ P) / m
+    return P
+
+
+def _boundary_mask(F, n):
+    edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    unique, count = np.unique(edges, axis=0, return_counts=True)
+    mask = np.zeros(n, dtype=bool)
+    mask[unique[count == 1].ravel()] = True
+    return mask
+
+
+@exercise(
+    "smoothing_loop",
+    reread=_REREAD_LOOP,
+    forbid=(
+        "lessons.smoothing.explicit_smoothing",
+        "lessons.smoothing.ExplicitSmoother",
+        "lessons.smoothing.implicit_smoothing",
+        "lessons.smoothing.ImplicitSmoother",
+        "lessons.operator.LaplaceOperator",
+        "lessons.operator.laplace_operator",
+    ),
+    own=("lessons.smoothing.explicit_smoothing", "lessons.smoothing.ExplicitSmoother"),
+)
+def smoothing_loop(fn):
+    """Check ``fn(V, F, tau, iterations) -> P``: ``iterations`` explicit steps P <- P + tau M^-1 C P
+    with the cotangent M and C built once from V, the boundary vertices held where they are."""
+    V, F = loop_case()
+    fixed = _boundary_mask(F, len(V))
+    M, C = laplacian(V, F)
+    I = ~fixed
+    lam_max = scipy.linalg.eigh(-C.toarray()[np.ix_(I, I)], np.diag(M.diagonal()[I]), eigvals_only=True)[-1]
+    tau, scale = 0.5 * 2 / lam_max, np.abs(V).max()
+    cases = [("an open noisy grid (20 boundary vertices)", V, F, fixed, 4), ("the same grid, 1 step", V, F, fixed, 1)]
+    ell = surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=1)
+    cases.append(("a closed ellipsoid (42 vertices)", ell.V, ell.F, np.zeros(len(ell.V), dtype=bool), 3))
+    checked = []
+    for label, V, F, fixed, n in cases:
+        if label.startswith("a closed"):
+            M, C = laplacian(V, F)
+            tau = 0.5 * 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[-1]
+        out = positions(call(fn, V.copy(), F.copy(), tau, n), len(V))
+        right = _smoothed(V, F, tau, n, fixed=fixed)
+        if close(out, right, rtol=0, atol=1e-9 * scale):
+            checked.append(label)
+            continue
+        _loop_mistake(out, V, F, tau, n, fixed, label)
+    return checked
+
+
+def _loop_mistake(out, V, F, tau, n, fixed, label):
+    """Raise the Mistake that explains ``out``: the nearest named variant of the loop, or a catch-all."""
+    atol = 1e-9 * np.abs(V).max()
+    if close(out, V, rtol=0, atol=atol):
+        raise Mistake(
+            f"the function returns the input positions unchanged: no step was taken (iterations = {n})",
+            "return the positions the loop computed, not V",
+        )
+    free = np.zeros(len(V), dtype=bool)
+    for rebuild in (False, True):
+        for held in (fixed, free):
+            for count in (n, n - 1, n + 1):
+                if (rebuild, held is fixed, count) == (False, True, n):
+                    continue
+                if close(out, _smoothed(V, F, tau, count, rebuild=rebuild, fixed=held), rtol=0, atol=atol):
+                    raise Mistake(*_loop_diagnosis(rebuild, held is fixed or not fixed.any(), count, n))
+    if close(out, _smoothed(V, F, -tau, n, fixed=fixed), rtol=0, atol=atol):
+        raise Mistake(
+            "the sign of the step is flipped: the loop runs the heat flow backwards and roughens the mesh",
+            "P <- P + tau M^-1 C P; C is negative semidefinite",
+        )
+    if close(out, _smoothed(V, F, tau, n, fixed=fixed, areas=False), rtol=0, atol=atol):
+        raise Mistake(
+            "C P is not divided by the vertex areas: the loop steps with C where M^-1 C belongs",
+            "divide row i of C P by M_ii",
+        )
+    if close(out, _smoothed(V, F, tau, n, weights="uniform", fixed=fixed), rtol=0, atol=atol):
+        raise Mistake(
+            "the loop smooths with the uniform operator; the task asks for the cotangent one",
+            "laplacian(V, F) with its default weights gives the cotangent M and C",
+        )
+    if fixed.any() and not close(out[fixed], V[fixed], rtol=0, atol=atol):
+        moved = np.linalg.norm(out[fixed] - V[fixed], axis=1).max()
+        raise Mistake(
+            f"the boundary vertices moved (the furthest by {moved:.3g}) on {label}",
+            "hold them: leave their rows out of the update, or put them back after every step",
+        )
+    raise Mistake(
+        f"the positions after {n} steps differ from the loop of P <- P + tau M^-1 C P on {label} "
+        f"(largest difference {np.abs(out - _smoothed(V, F, tau, n, fixed=fixed)).max():.3g})",
+        "build M and C once from V, then repeat the step `iterations` times, boundary rows held",
+        typical=False,
+    )
+
+
+def _loop_diagnosis(rebuild, boundary_held, count, n):
+    """(diagnosis, hint) of a loop that differs from the task in the ways named."""
+    parts, hints = [], []
+    if rebuild:
+        parts.append(
+            "M and C are rebuilt from the moving mesh at every step, where the task builds them once "
+            "from the input (that is curvature flow, not the fixed-operator smoothing asked for)"
+        )
+        hints.append("call laplacian(V, F) once, before the loop")
+    if not boundary_held:
+        parts.append("the boundary moves: every vertex was updated")
+        hints.append("hold the boundary vertices (leave their rows out, or put them back after every step)")
+    if count != n:
+        parts.append(
+            f"the loop takes {count} steps for iterations = {n}"
+            + (" (one too few)" if count < n else " (one too many)")
+        )
+        hints.append("range(iterations) runs exactly `iterations` steps")
+    return "; ".join(parts), "; ".join(hints)
