@@ -35,8 +35,14 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 EXERCISE_NOTEBOOKS = [p for p in NOTEBOOKS if p.name[:2] != "00" and p.name[2] == "_"]
 BIN = Path(sys.executable).parent
 ASSIGNMENT = "curvature"
-# the notebooks the three students hand in: the first task and the smoothing tasks
-GRADED = {"01": "01_uniform_laplace_curvature", "05": "05_explicit_smoothing"}
+# the notebooks the three students hand in: the first task and those whose exercises carry the
+# coursework (the eigenproblem, the smoothing loop, the denoising experiment)
+GRADED = {
+    "01": "01_uniform_laplace_curvature",
+    "04": "04_spectral_reconstruction",
+    "05": "05_explicit_smoothing",
+    "07": "07_denoising_evaluation",
+}
 WRONG_EXERCISE = "uniform_laplacian"
 DIAGNOSIS = "the sign of C is flipped"
 GRADING = ROOT / "docs" / "grading.md"
@@ -44,7 +50,8 @@ GRADING = ROOT / "docs" / "grading.md"
 
 def guide_points():
     """{(notebook, exercise): (check, partial credit, by hand, total)} from the grading guide's table."""
-    rows = re.findall(r"^\| (\d\d) \| `(\w+)` \| (\d*) \| (\d*) \| (\d*) \| (\d+) \|$", GRADING.read_text(), flags=re.M)
+    cell = r"\|\s*(\d*)\s*"
+    rows = re.findall(rf"^\| (\d\d) \| `(\w+)` {cell * 3}\| (\d+) \|$", GRADING.read_text(), flags=re.M)
     return {(nb, ex): tuple(int(x or 0) for x in values) for nb, ex, *values in rows}
 
 
