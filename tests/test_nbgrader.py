@@ -186,12 +186,13 @@ def test_autograde_scores_stubs_zero_a_typical_mistake_fewer_solutions_full_and_
             assert [nb.max_score for nb in got] == [a + h for a, h in zip(auto, hand)]
             # an answer box left blank scores 0 at once; a written answer waits for a grader
             assert all(nb.needs_manual_grade == (student != "stubs") for nb in got), student
-        # a grader enters the hand-graded points of the solved student: the score includes them
+        # a grader enters the hand-graded points of the solved student, as the formgrader's grade
+        # handler does (the score and the flag): the score includes them
         for name in GRADED.values():
             submission = gb.find_submission_notebook(name, ASSIGNMENT, "solved")
             for grade in submission.grades:
                 if grade.cell.max_score and grade.needs_manual_grade:
-                    grade.manual_score = grade.cell.max_score
+                    grade.manual_score, grade.needs_manual_grade = grade.cell.max_score, False
             gb.db.commit()
         got = [gb.find_submission_notebook(name, ASSIGNMENT, "solved") for name in GRADED.values()]
         assert [nb.score for nb in got] == [a + h for a, h in zip(auto, hand)]
