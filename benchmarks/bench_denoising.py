@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Speed of the denoising evaluation (notebook 07): the sweep and the metrics.
+"""Speed of the denoising evaluation (notebook 07 and its appendix 07a): the sweep and the metrics.
 
     python benchmarks/bench_denoising.py [--repeats 3]
 
 Prints, on the meshes the notebook uses (geomlib/meshes/sphere.obj and geomlib/meshes/cad_part.obj):
 
-* the full sweep of notebook 07 (5 noise levels x 4 schemes x 4 steps x 9
+* the full sweep of notebook 07a (5 noise levels x 4 schemes x 4 steps x 9
   iteration counts per mesh, one run per setting through the smoothing
   callback, implicit factorised once per step) against the 60 s budget;
 * the same sweep done the obvious way for one noise level (one smoothing call

@@ -59,14 +59,70 @@ def test_controls_are_disabled_and_noted():
     nb, state = _notebook()
     assert build_site.prepare_for_site(nb) == 2
     assert state["slider"]["state"]["disabled"] is True
-    first = nb.cells[0].outputs  # view, its hidden still, the note
-    assert len(first) == 3 and build_site.WIDGET_VIEW in first[0]["data"]
+    first = nb.cells[0].outputs  # view, its hidden still, the keys that move it, the note
+    assert len(first) == 4 and build_site.WIDGET_VIEW in first[0]["data"]
     assert 'class="site-still" hidden' in first[1]["data"]["text/html"]
     assert "base64,iVBORw0KGgo=" in first[1]["data"]["text/html"]
-    assert build_site.KERNEL_NOTE in first[2]["data"]["text/html"]
+    assert build_site.VIEW_KEYS in first[2]["data"]["text/html"]
+    assert build_site.KERNEL_NOTE in first[3]["data"]["text/html"]
     # no control in the second cell: no note; the label has no still
-    assert len(nb.cells[1].outputs) == 3
+    assert len(nb.cells[1].outputs) == 4
     assert all("site-kernel-note" not in str(o) for o in nb.cells[1].outputs)
+
+
+def test_stills_and_figures_keep_their_alt_text():
+    nb, state = _notebook()
+    nb.cells[0].outputs[0]["metadata"] = {"image/png": {"alt": 'A view of "H" & K'}}
+    figure = nbformat.v4.new_output(
+        "display_data",
+        data={"image/png": "iVBORw0KGgo=", "text/plain": "Figure"},
+        metadata={"image/png": {"alt": "a plot"}},
+    )
+    state["out"] = _model("OutputModel", module="@jupyter-widgets/output", outputs=[figure])
+    build_site.prepare_for_site(nb)
+    assert 'alt="A view of &quot;H&quot; &amp; K"' in nb.cells[0].outputs[1]["data"]["text/html"]
+    assert 'alt="still picture of the 3D view"' in nb.cells[1].outputs[1]["data"]["text/html"]  # no metadata
+    (shown,) = state["out"]["state"]["outputs"]
+    assert shown["data"]["text/html"] == '<img src="data:image/png;base64,iVBORw0KGgo=" alt="a plot">'
+    assert "image/png" not in shown["data"]
+    # a page's own figures: the template writes the alt of the output's metadata
+    page = nbformat.v4.new_notebook()
+    page.cells = [nbformat.v4.new_code_cell("fig")]
+    page.cells[0].outputs = [figure, nbformat.v4.new_output("display_data", data={"image/png": "iVBORw0KGgo="})]
+    body, _ = build_site.exporter().from_notebook_node(page, resources={"site_nav": "", "metadata": {"name": "t"}})
+    assert body.count('alt="a plot"') == 1
+    assert body.count("No description has been provided") == 1  # the figure without alt is not given one
+
+
+def test_pages_have_a_skip_link_a_live_region_and_labelled_navigation():
+    nb, _ = _notebook()
+    nav = build_site.nav_html([{"file": "a.html", "title": "A"}, {"file": "b.html", "title": "B"}], 0)
+    body, _ = build_site.exporter().from_notebook_node(nb, resources={"site_nav": nav, "metadata": {"name": "t"}})
+    assert body.index(build_site.SKIP_LINK) < body.index("<main") < body.index("</main>")
+    assert '<main id="site-content"' in body and 'aria-live="polite"' in body
+    navs = re.findall(r"<nav [^>]*>", body)
+    assert len(navs) == 2 and all("aria-label=" in n for n in navs)
+    main = body[body.index("<main") : body.index("</main>")]
+    assert "<nav" not in main  # both bars outside the content the skip link jumps to
+    assert "inTabOrder: false" in body and build_site.A11Y_JS in body
+
+
+def test_theme_colours_meet_wcag_aa():
+    def luminance(hex_colour):
+        rgb = [int(hex_colour[i : i + 2], 16) / 255 for i in (1, 3, 5)]
+        rgb = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in rgb]
+        return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+
+    def contrast(a, b):
+        hi, lo = sorted((luminance(a), luminance(b)), reverse=True)
+        return (hi + 0.05) / (lo + 0.05)
+
+    colours = dict(re.findall(r"--jp-([a-z-]+-color): (#[0-9a-f]{6})", build_site.A11Y_CSS))
+    assert len(colours) >= 12
+    for name, colour in colours.items():  # code on the cells' grey, prompts on white
+        assert contrast(colour, "#f5f5f5" if "mirror" in name else "#ffffff") >= 4.5, (name, colour)
+    track = re.search(r"\.noUi-target \{ background: (#[0-9a-f]{6})", build_site.A11Y_CSS)[1]
+    assert contrast(track, "#ffffff") >= 3.0  # a slider's track against the page (WCAG 1.4.11)
 
 
 def test_several_controls_get_one_plural_note():

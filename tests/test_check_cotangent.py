@@ -75,6 +75,8 @@ def learner_laplacian(
     boundary="natural",
     M_rule="barycentric",
     dense=False,
+    weights="cotan",
+    divide_by_areas=False,
 ):
     n = len(V)
     C = np.zeros((n, n)) if dense else sp.lil_matrix((n, n))
@@ -84,7 +86,7 @@ def learner_laplacian(
         for c in range(3):
             i, j, k = f[c], f[(c + 1) % 3], f[(c + 2) % 3]
             at = {"opposite": (k, i, j), "at i": (i, j, k), "at j": (j, k, i)}[angle]
-            w = sign * factor * cot(V, *at)
+            w = sign * factor * cot(V, *at) if weights == "cotan" else 0.5
             if tuple(sorted((i, j))) in bedges:
                 w *= {"natural": 1.0, "left out": 0.0, "no half": 2.0}.get(boundary, 1.0)
             C[i, j] += w
@@ -106,6 +108,8 @@ def learner_laplacian(
         C = C - (np.diag(C.sum(axis=1)) if dense else sp.diags(np.asarray(C.sum(axis=1)).ravel()))
     if boundary == "rows zeroed":  # a fixed-boundary pipeline's matrix
         C = sp.csr_matrix(sp.diags((~on).astype(float)) @ C)
+    if divide_by_areas:  # the operator Delta = M^-1 C handed in as C
+        C = sp.diags(1 / A) @ C
     M = np.eye(n) if M_rule == "identity" else (np.diag(A) if dense else sp.diags(A))
     return M, C
 
@@ -140,6 +144,9 @@ WRONG_LAPLACIANS = [
     (dict(angle="at i"), "cotangent of the wrong angle"),
     (dict(angle="at j"), "cotangent of the wrong angle"),
     (dict(cot=tan_at), "tan is used instead of cot"),
+    (dict(weights="uniform"), "these are the uniform weights (1 for every edge)"),
+    (dict(divide_by_areas=True), "C is already divided by the vertex areas"),
+    (dict(divide_by_areas=True, M_rule="meyer"), "C is already divided by the vertex areas"),
     # issue 29, class 6: a zeroed boundary row is the boundary rule, not a symmetry slip
     (dict(boundary="rows zeroed"), "rows of the boundary vertices are zeroed"),
     (dict(boundary="left out"), "boundary edges are left out"),

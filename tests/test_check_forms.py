@@ -56,6 +56,12 @@ FORM_MISTAKES = {
         "E and G are exchanged",
     ),
     "fresh symbols": (lambda a, b, c, u, v: forms(a, b, c, *sp.symbols("s t")), "other than a, b, c, u, v"),
+    "F with its sign flipped": (lambda *x: (forms(*x)[0], -forms(*x)[1]) + forms(*x)[2:], "F has the wrong sign"),
+    "normal of length 2": (lambda *x: forms(*x)[:3] + tuple(2 * y for y in forms(*x)[3:]), "off by the same factor 2"),
+    "e and g exchanged": (
+        lambda *x: forms(*x)[:3] + (forms(*x)[5], forms(*x)[4], forms(*x)[3]),
+        "e and g are exchanged",
+    ),
     "three values": (lambda *x: forms(*x)[:3], "not (E, F, G, e, f, g) or (I, II)"),
 }
 
@@ -66,12 +72,11 @@ def test_forms_accept_reference_simplified_or_not():
         assert result.passed, result.message
     from geomlib.lessons.symbolic import ellipsoid
 
-    def library(a, b, c, u, v):
-        ell = ellipsoid(a, b, c)
-        sub = {ell.u: u, ell.v: v}
-        return ell.first_fundamental_form().subs(sub), ell.second_fundamental_form().subs(sub)
-
-    assert check.fundamental_forms(library).passed
+    # the library's simplified forms, derived before the check (its ground rules refuse a call inside)
+    ell = ellipsoid(*sp.symbols("a b c", positive=True))
+    simplified = ell.first_fundamental_form(), ell.second_fundamental_form()
+    result = check.fundamental_forms(lambda a, b, c, u, v: simplified)
+    assert result.passed, result.message
 
 
 def test_forms_check_is_quick():
@@ -83,7 +88,7 @@ def test_forms_check_is_quick():
 @pytest.mark.parametrize("name", FORM_MISTAKES)
 def test_forms_diagnoses(name):
     fn, phrase = FORM_MISTAKES[name]
-    assert_diagnosed(check.fundamental_forms(fn), phrase, "Reread Steps 2 to 4")
+    assert_diagnosed(check.fundamental_forms(fn), phrase, "Reread The definitions and Steps 1-2")
 
 
 def test_forms_stub():
@@ -113,6 +118,19 @@ KAPPA_MISTAKES = {
         "(u, v) parameter plane",
     ),
     "sign": (lambda a, b, c, phi: -kappa(a, b, c, phi), "sign is flipped"),
+    "only E divides": (lambda a, b, c, phi: a / b**2 + 0 * phi, "only E divides"),
+    "lengths, not their squares": (
+        lambda a, b, c, phi: a * np.cos(phi) ** 2 / b + a * np.sin(phi) ** 2 / c,
+        "divided by the length |p_u| = b",
+    ),
+    "divided twice": (
+        lambda a, b, c, phi: a * np.cos(phi) ** 2 / b**4 + a * np.sin(phi) ** 2 / c**4,
+        "the first form divides twice",
+    ),
+    "a cross term": (
+        lambda a, b, c, phi: kappa(a, b, c, phi) + np.sin(2 * phi) * a / (b * c),
+        "right along p_u and p_v but not between them",
+    ),
     "symbolic leftover": (lambda a, b, c, phi: sp.Symbol("phi") * a, "not a number"),
 }
 
@@ -126,8 +144,44 @@ def test_kappa_accepts_reference():
 @pytest.mark.parametrize("name", KAPPA_MISTAKES)
 def test_kappa_diagnoses(name):
     fn, phrase = KAPPA_MISTAKES[name]
-    assert_diagnosed(check.normal_curvature(fn), phrase, "Reread Step 6")
+    assert_diagnosed(check.normal_curvature(fn), phrase, "Reread Step 4")
 
 
 def test_kappa_stub():
     assert_diagnosed(check.normal_curvature(stub), "not written yet")
+
+
+def kappa_numpy_rounded(a, b, c, phi):
+    # II(t, t) / I(t, t) with numpy matrices, a rounded constant (phi shifted by a period of 3.14159265)
+    t = np.array([np.cos(phi + 2 * 3.14159265) / b, np.sin(phi + 2 * 3.14159265) / c])
+    return (t @ np.diag([a, a]) @ t) / (t @ np.diag([b * b, c * c]) @ t)
+
+
+def test_kappa_accepts_a_rounded_constant():
+    result = check.normal_curvature(kappa_numpy_rounded)
+    assert result.passed, result.message
+
+
+def following(hint):
+    """kappa_n as a learner writes it from a hint's "(du, dv) = (X, Y)" and its kappa_n = II(t, t) / I(t, t)."""
+    du, dv = hint.split("(du, dv) = (", 1)[1].split(")", 1)[0].replace(" phi", "(phi)").split(", ")
+
+    def kappa_n(a, b, c, phi):
+        names = {"cos": np.cos, "sin": np.sin, "phi": phi, "b": b, "c": c}
+        t = np.array([eval(du, names), eval(dv, names)])  # noqa: S307 (the hint's own formula)
+        return (t @ np.diag([a, a]) @ t) / (t @ np.diag([b * b, c * c]) @ t)
+
+    return kappa_n
+
+
+@pytest.mark.parametrize("name", ["no division by I", "parameter-plane angle", "lengths, not their squares"])
+def test_a_hint_that_gives_the_unit_tangent_leads_to_the_right_answer(name):
+    """W3: the hint names (du, dv) of the unit tangent; a learner who follows it passes (the old hint,
+    (du, dv) = (cos phi, sin phi), led to the very mistake the check diagnoses)."""
+    message = check.normal_curvature(KAPPA_MISTAKES[name][0]).message
+    hint = message.split("Hint:", 1)[1]
+    assert "(du, dv) = (" in hint, message
+    result = check.normal_curvature(following(hint))
+    assert result.passed, (message, result.message)
+    # and the old hint's tangent is diagnosed, not passed
+    assert_diagnosed(check.normal_curvature(following("(du, dv) = (cos phi, sin phi)")), "(u, v) parameter plane")

@@ -184,14 +184,14 @@ def test_the_equivalent_implicit_form_passes():
 @pytest.mark.parametrize("name", STEP_MISTAKES)
 def test_explicit_step_mistakes(name):
     fn, phrase = STEP_MISTAKES[name]
-    assert_diagnosed(check.explicit_step(fn), phrase, "Reread section 2 · Discretised in space and time")
+    assert_diagnosed(check.explicit_step(fn), phrase, "Reread section 1 · The heat flow, one explicit step at a time")
 
 
 @pytest.mark.parametrize("name", LIMIT_MISTAKES)
 def test_explicit_step_limit_mistakes(name):
     wrong, phrase = LIMIT_MISTAKES[name]
     assert_diagnosed(
-        check.explicit_step_limit(on_matrices(wrong)), phrase, "Reread section 3 · Why the step has a limit"
+        check.explicit_step_limit(on_matrices(wrong)), phrase, "Reread section 2 · Why the step has a limit"
     )
 
 
@@ -345,7 +345,7 @@ def test_any_way_of_holding_the_boundary_passes(name):
 def test_smoothing_loop_mistakes(name):
     fn, phrase = LOOP_MISTAKES[name]
     result = check.smoothing_loop(fn)
-    assert_diagnosed(result, phrase, "Reread section 4 · The smoothing loop, boundary held")
+    assert_diagnosed(result, phrase, "Reread section 3 · The smoothing loop, boundary held")
     assert check.smoothing_loop.partial_credit(fn).passed == (name != "something else"), result.message
 
 

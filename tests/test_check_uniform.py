@@ -1,12 +1,13 @@
-"""The checks of notebook 01's exercises: the reference passes, typical mistakes get their diagnosis."""
+"""The checks of notebook 01's exercises, tried with answers written fresh as learners write them (numpy and
+scipy only: the ground rules refuse geomlib's own routines): correct variants pass, each typical mistake gets
+its diagnosis, and a catch-all never hides a mistake the check can name."""
 
 import numpy as np
 import pytest
+import scipy.sparse as sparse
 from diagnoses import assert_diagnosed
 
 from geomlib import check
-from geomlib.lessons.curvature import angle_deficit, gaussian_curvature
-from geomlib.lessons.laplace import barycentric_areas, laplacian, mixed_areas
 from geomlib.teaching.check import CheckFailed
 
 
@@ -20,91 +21,282 @@ def stub(V, F):
     raise NotImplementedError("Your turn")
 
 
-# ---------------------------------------------------------------- uniform_laplacian
-def uniform(V, F):
-    return laplacian(V, F, weights="uniform")
+# ---------------------------------------------------------------- uniform_laplacian, written fresh
+def directed(V, F):
+    """(n, n) dense: how many triangles list i -> j as one of their edges."""
+    D = np.zeros((len(V), len(V)))
+    for a, b in ((0, 1), (1, 2), (2, 0)):
+        np.add.at(D, (F[:, a], F[:, b]), 1.0)
+    return D
+
+
+def adjacency(V, F):
+    return ((directed(V, F) + directed(V, F).T) > 0).astype(float)
+
+
+def triangles_at(V, F):
+    return np.bincount(F.ravel(), minlength=len(V)).astype(float)
+
+
+def uniform_pair(V, F, A=None, diagonal=None, M=None):
+    A = adjacency(V, F) if A is None else A
+    valence = adjacency(V, F).sum(axis=1)
+    C = A - np.diag(valence if diagonal is None else diagonal)
+    return (np.diag(valence) if M is None else M), C
+
+
+def uniform_sparse(V, F):
+    """A learner's sparse solution: coo with duplicates summed, then clipped to 1."""
+    n = len(V)
+    I, J = F.ravel(), F[:, [1, 2, 0]].ravel()
+    W = sparse.coo_matrix((np.ones(len(I)), (I, J)), shape=(n, n)).tocsr()
+    A = ((W + W.T) > 0).astype(float)
+    valence = np.asarray(A.sum(axis=1)).ravel()
+    return sparse.diags(valence), (A - sparse.diags(valence)).tocsr()
+
+
+def uniform_edge_loop(V, F):
+    """Another correct answer: a set of undirected edges, dense matrices, float32."""
+    n = len(V)
+    edges = {tuple(sorted((int(f[a]), int(f[b])))) for f in F for a, b in ((0, 1), (1, 2), (2, 0))}
+    C = np.zeros((n, n), np.float32)
+    for i, j in edges:
+        C[i, j] = C[j, i] = 1
+    valence = C.sum(axis=1)
+    return np.diag(valence), C - np.diag(valence)
+
+
+def cotangent_pair(V, F):
+    """The cotangent (M, C) of notebook 03, written out."""
+    n = len(V)
+    C, M = np.zeros((n, n)), np.zeros(n)
+    for k in range(3):
+        i, j, o = F[:, (k + 1) % 3], F[:, (k + 2) % 3], F[:, k]
+        a, b = V[i] - V[o], V[j] - V[o]
+        cross = np.linalg.norm(np.cross(a, b), axis=1)
+        w = 0.5 * np.einsum("ij,ij->i", a, b) / cross
+        np.add.at(C, (i, j), w)
+        np.add.at(C, (j, i), w)
+        np.add.at(M, o, cross / 6)
+    return np.diag(M), C - np.diag(C.sum(axis=1))
 
 
 UNIFORM_MISTAKES = {
-    "flipped sign": (lambda V, F: (uniform(V, F)[0], -uniform(V, F)[1]), "sign of C is flipped"),
-    "no diagonal": (
-        lambda V, F: (uniform(V, F)[0], uniform(V, F)[1] - np.diag(uniform(V, F)[1].diagonal())),
-        "diagonal of C is missing",
+    "flipped sign": (lambda V, F: (uniform_pair(V, F)[0], -uniform_pair(V, F)[1]), "sign of C is flipped"),
+    "no diagonal": (lambda V, F: uniform_pair(V, F, diagonal=np.zeros(len(V))), "diagonal of C is missing"),
+    "+valence on the diagonal": (
+        lambda V, F: uniform_pair(V, F, diagonal=-adjacency(V, F).sum(axis=1)),
+        "diagonal of C has the wrong sign",
     ),
-    "M^-1 C": (
-        lambda V, F: (uniform(V, F)[0], uniform(V, F)[1] / uniform(V, F)[0].diagonal()[:, None]),
+    "M^-1 C as C": (
+        lambda V, F: (uniform_pair(V, F)[0], uniform_pair(V, F)[1] / adjacency(V, F).sum(axis=1)[:, None]),
         "M^-1 C, not C",
     ),
-    "identity M": (lambda V, F: (np.eye(len(V)), uniform(V, F)[1]), "M is the identity"),
-    "only C": (lambda V, F: uniform(V, F)[1], "not the pair (M, C)"),
+    "diag(1/valence) @ A - I as C, M = I": (
+        lambda V, F: (np.eye(len(V)), np.diag(1 / adjacency(V, F).sum(axis=1)) @ adjacency(V, F) - np.eye(len(V))),
+        "M^-1 C, not C",
+    ),
+    "one per triangle": (
+        lambda V, F: uniform_pair(
+            V, F, A=directed(V, F) + directed(V, F).T, diagonal=(directed(V, F) + directed(V, F).T).sum(axis=1)
+        ),
+        "an edge counts once per triangle",
+    ),
+    "triangles on the diagonal": (
+        lambda V, F: uniform_pair(V, F, diagonal=triangles_at(V, F)),
+        "the diagonal counts the triangles",
+    ),
+    "one direction per edge": (
+        lambda V, F: uniform_pair(V, F, A=directed(V, F), diagonal=directed(V, F).sum(axis=1)),
+        "only in the direction the triangles list it",
+    ),
+    "a cotangent C": (cotangent_pair, "C holds the cotangent weights"),
+    "identity M": (lambda V, F: uniform_pair(V, F, M=np.eye(len(V))), "M is the identity"),
+    "negative M": (lambda V, F: uniform_pair(V, F, M=-np.diag(adjacency(V, F).sum(axis=1))), "M has the wrong sign"),
+    "diag(1/valence) as M": (
+        lambda V, F: uniform_pair(V, F, M=np.diag(1 / adjacency(V, F).sum(axis=1))),
+        "M holds 1/valence: that is M^-1",
+    ),
+    "triangles in M": (lambda V, F: uniform_pair(V, F, M=np.diag(triangles_at(V, F))), "M counts the triangles"),
+    "areas in M": (lambda V, F: (cotangent_pair(V, F)[0], uniform_pair(V, F)[1]), "M holds vertex areas"),
+    "M as a vector": (lambda V, F: (adjacency(V, F).sum(axis=1), uniform_pair(V, F)[1]), "M is a vector"),
+    "only C": (lambda V, F: uniform_pair(V, F)[1], "not the pair (M, C)"),
 }
 
 
-def test_uniform_accepts_reference():
-    result = check.uniform_laplacian(uniform)
-    assert result.passed and "tetrahedron" in result.message
+@pytest.mark.parametrize("fn", [uniform_pair, uniform_sparse, uniform_edge_loop])
+def test_uniform_accepts_correct_variants(fn):
+    result = check.uniform_laplacian(fn)
+    assert result.passed and "tetrahedron" in result.message and "icosphere" in result.message, result.message
+
+
+def test_uniform_accepts_any_vertex_order_of_the_faces():
+    def rotated(V, F):
+        return uniform_sparse(V, np.roll(F, 1, axis=1))
+
+    assert check.uniform_laplacian(rotated).passed
 
 
 @pytest.mark.parametrize("name", UNIFORM_MISTAKES)
 def test_uniform_diagnoses(name):
     fn, phrase = UNIFORM_MISTAKES[name]
-    assert_diagnosed(check.uniform_laplacian(fn), phrase, "Reread section 2")
+    result = check.uniform_laplacian(fn)
+    assert_diagnosed(result, phrase, "Reread section 2")
+    named = name not in ("only C",)
+    assert result.partial == named, result.message
+
+
+def test_uniform_unnamed_mistake_is_the_catch_all_without_partial_credit():
+    def noisy(V, F):
+        M, C = uniform_pair(V, F)
+        C = C.copy()
+        C[0, 1] = C[1, 0] = 0.5
+        return M, C
+
+    result = check.uniform_laplacian(noisy)
+    assert_diagnosed(result, "C differs from the uniform Laplacian")
+    assert not result.partial
 
 
 def test_uniform_stub_is_not_written_yet():
     assert_diagnosed(check.uniform_laplacian(stub), "not written yet")
 
 
-# ---------------------------------------------------------------- gaussian_curvature (angle deficit)
-def pointwise_K(V, F):
-    """The exercise written out as a learner would: angles by arccos, barycentric areas, NaN on the boundary."""
-    theta = np.zeros(len(V))
-    area = np.zeros(len(V))
+# ---------------------------------------------------------------- gaussian_curvature, written fresh
+def corner_angles(V, F, pi=np.pi, dtype=float):
+    """(m, 3) angles by arccos, in radians (``pi`` only for the degrees variant)."""
+    theta = np.zeros(F.shape, dtype)
     for k in range(3):
-        i, j, l = F[:, k], F[:, (k + 1) % 3], F[:, (k + 2) % 3]
-        a, b = V[j] - V[i], V[l] - V[i]
+        a, b = V[F[:, (k + 1) % 3]] - V[F[:, k]], V[F[:, (k + 2) % 3]] - V[F[:, k]]
         cos = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-        np.add.at(theta, i, np.arccos(np.clip(cos, -1, 1)))
-        np.add.at(area, i, np.linalg.norm(np.cross(a, b), axis=1) / 6)
-    K = (2 * np.pi - theta) / area
+        theta[:, k] = np.arccos(np.clip(cos, -1, 1)) * (pi / np.pi)
+    return theta
+
+
+def face_area(V, F):
+    return np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1) / 2
+
+
+def boundary(V, F):
     edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
     e, count = np.unique(edges, axis=0, return_counts=True)
-    K[np.unique(e[count == 1])] = np.nan
+    mask = np.zeros(len(V), bool)
+    mask[np.unique(e[count == 1])] = True
+    return mask
+
+
+def vertex_area(V, F, how="third"):
+    n, Af = len(V), face_area(V, F)
+    summed = np.bincount(F.ravel(), weights=np.repeat(Af, 3), minlength=n)
+    if how == "third":
+        return summed / 3
+    if how == "full":
+        return summed
+    if how == "ninth":
+        return summed / 9
+    if how == "mean":  # the mean of the incident A_f / 3, not their sum
+        return summed / 3 / np.bincount(F.ravel(), minlength=n)
+    if how == "twice":  # the cross product's length taken as the area
+        return 2 * summed / 3
+    if how in ("mixed", "voronoi"):
+        A = np.zeros(n)
+        theta = corner_angles(V, F)
+        cot = 1 / np.tan(theta)
+        for k in range(3):
+            i, j, o = F[:, k], F[:, (k + 1) % 3], F[:, (k + 2) % 3]
+            lj, lo = np.sum((V[o] - V[i]) ** 2, axis=1), np.sum((V[j] - V[i]) ** 2, axis=1)
+            piece = (lo * cot[:, (k + 2) % 3] + lj * cot[:, (k + 1) % 3]) / 8
+            if how == "mixed":
+                obtuse = (theta > np.pi / 2).any(axis=1)
+                piece = np.where(obtuse, np.where(theta[:, k] > np.pi / 2, Af / 2, Af / 4), piece)
+            np.add.at(A, i, piece)
+        return A
+    raise ValueError(how)
+
+
+def learner_K(V, F, two_pi=2 * np.pi, area="third", rule="nan", sign=1.0, pi=np.pi, divide=True, dtype=float):
+    theta_sum = np.bincount(F.ravel(), weights=corner_angles(V, F, pi, dtype).ravel(), minlength=len(V))
+    deficit = sign * (two_pi - theta_sum) if pi == np.pi else (360.0 - theta_sum)
+    K = deficit / vertex_area(V, F, area) if divide else deficit
+    if rule == "nan":
+        K[boundary(V, F)] = np.nan
+    elif rule == "zero":
+        K[boundary(V, F)] = 0.0
     return K
 
 
+K_CORRECT = {
+    "written out": learner_K,
+    "pi to 7 digits": lambda V, F: learner_K(V, F, two_pi=2 * 3.141593),
+    "pi to 7 digits, 2 pi as 6.283185": lambda V, F: learner_K(V, F, two_pi=6.283185),
+    "single-precision angles": lambda V, F: learner_K(V, F, dtype=np.float32),
+    "rotated faces": lambda V, F: learner_K(V, np.roll(F, 2, axis=1)),
+}
+
 K_MISTAKES = {
-    "sign": (lambda V, F: -gaussian_curvature(V, F), "sign of the deficit is flipped"),
-    "area not / 3": (lambda V, F: gaussian_curvature(V, F) / 3, "not divided by 3"),
-    "degrees": (lambda V, F: np.degrees(gaussian_curvature(V, F)), "in degrees"),
-    "integrated": (lambda V, F: gaussian_curvature(V, F, integrated=True), "not divided by the vertex area"),
-    "mixed area": (lambda V, F: gaussian_curvature(V, F, area="mixed"), "mixed Voronoi area"),
-    "interior rule on the boundary": (
-        lambda V, F: angle_deficit(V, F) / barycentric_areas(V, F),
-        "interior formula is applied at boundary vertices",
+    "sign": (lambda V, F: learner_K(V, F, sign=-1.0), "sign of the deficit is flipped"),
+    "degrees": (lambda V, F: learner_K(V, F, pi=180.0), "in degrees"),
+    "integrated": (lambda V, F: learner_K(V, F, divide=False), "not divided by the vertex area"),
+    "full area": (lambda V, F: learner_K(V, F, area="full"), "full area of its incident triangles"),
+    "a ninth": (lambda V, F: learner_K(V, F, area="ninth"), "a ninth"),
+    "mean of the A_f / 3": (lambda V, F: learner_K(V, F, area="mean"), "the mean of its triangles' pieces"),
+    "mean, pi to 7 digits": (
+        lambda V, F: learner_K(V, F, two_pi=2 * 3.141593, area="mean"),
+        "the mean of its triangles' pieces",
     ),
-    "zero on the boundary": (lambda V, F: gaussian_curvature(V, F, boundary="zero"), "boundary vertices have a value"),
-    "a matrix": (lambda V, F: np.diag(gaussian_curvature(V, F)), "expected (4,)"),
+    "cross product as area": (lambda V, F: learner_K(V, F, area="twice"), "twice the right one"),
+    "mixed area": (lambda V, F: learner_K(V, F, area="mixed"), "mixed (Voronoi) areas"),
+    "plain Voronoi area": (lambda V, F: learner_K(V, F, area="voronoi"), "plain Voronoi areas"),
+    "no boundary rule": (lambda V, F: learner_K(V, F, rule=None), "interior formula is applied at boundary"),
+    "no boundary rule, pi to 7 digits": (
+        lambda V, F: learner_K(V, F, two_pi=2 * 3.141593, rule=None),
+        "interior formula is applied at boundary",
+    ),
+    "zero on the boundary": (lambda V, F: learner_K(V, F, rule="zero"), "boundary vertices have a value"),
+    "a matrix": (lambda V, F: np.diag(learner_K(V, F, rule="zero")), "expected (4,)"),
 }
 
 
-def test_K_accepts_reference_and_written_solution():
-    for fn in (gaussian_curvature, pointwise_K):
-        result = check.gaussian_curvature(fn)
-        assert result.passed and "bump" in result.message, result.message
-
-
-def test_mixed_and_barycentric_differ_on_the_check_mesh():
-    # otherwise the "mixed area" diagnosis could not be told apart from a correct answer
-    from geomlib.teaching.check.uniform import _TET_F, _TET_V
-
-    assert not np.allclose(mixed_areas(_TET_V, _TET_F), barycentric_areas(_TET_V, _TET_F))
+@pytest.mark.parametrize("name", K_CORRECT)
+def test_K_accepts_correct_variants(name):
+    result = check.gaussian_curvature(K_CORRECT[name])
+    assert result.passed and "bump" in result.message and "icosphere" in result.message, result.message
 
 
 @pytest.mark.parametrize("name", K_MISTAKES)
 def test_K_diagnoses(name):
     fn, phrase = K_MISTAKES[name]
-    assert_diagnosed(check.gaussian_curvature(fn), phrase, "Reread section 3")
+    result = check.gaussian_curvature(fn)
+    assert_diagnosed(result, phrase, "Reread section 3")
+    assert result.partial == (name != "a matrix"), result.message
+
+
+def test_the_mean_area_is_told_from_a_ninth_by_the_meshes_whose_valences_differ():
+    # on the tetrahedron alone (valence 3 everywhere) the two coincide
+    from geomlib.teaching.check.uniform import _K_CASES
+
+    valences = [np.bincount(F.ravel()) for _, _, F in _K_CASES]
+    assert set(valences[0]) == {3} and any(len(set(v)) > 1 for v in valences[1:])
+    result = check.gaussian_curvature(K_MISTAKES["mean of the A_f / 3"][0])
+    assert "ninth" not in result.message, result.message
+
+
+def test_K_catch_all_still_names_the_missing_boundary_rule():
+    def wrong_inside_too(V, F):
+        K = learner_K(V, F, rule=None)
+        return K + 0.5 * np.sin(np.arange(len(K)))
+
+    result = check.gaussian_curvature(wrong_inside_too)
+    assert_diagnosed(result, "K differs", "have values, where K is not defined")
+    assert not result.partial
+
+
+def test_the_checks_meshes_hold_obtuse_triangles_and_a_boundary():
+    from geomlib.teaching.check.uniform import _K_CASES, _UNIFORM_CASES
+
+    for cases in (_K_CASES, _UNIFORM_CASES):
+        assert any((corner_angles(V, F) > np.pi / 2).any() for _, V, F in cases)
+        assert any(boundary(V, F).any() for _, V, F in cases)
 
 
 def test_K_stub_and_strict_mode(monkeypatch):

@@ -63,3 +63,27 @@ def test_the_figures_say_what_they_draw():
 def test_a_zero_area_triangle_has_no_gradient():
     with pytest.raises(MeshError, match="zero-area"):
         d.hat_gradients(np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]]), np.array([[0, 1, 2]]))
+
+
+def test_the_convergence_figure_shows_every_slope_once_and_says_them():
+    from geomlib.teaching.convergence import error_figure
+
+    ell = [0.2, 0.1, 0.05]
+    rows = {
+        "regular": [
+            {"n": 10 * 4**s, "ell": e, ("H", "a"): (e**2, 0.1), ("K", "b"): (e, 0.2)} for s, e in enumerate(ell)
+        ],
+        "jittered": [
+            {"n": 10 * 4**s, "ell": e, ("H", "a"): (0.03, 0.3), ("K", "b"): (0.04, 0.4)} for s, e in enumerate(ell)
+        ],
+    }
+    slopes = {
+        (f, k, st): (2.0 if f == "regular" and st == "median" and k[0] == "H" else -0.001)
+        for f in rows
+        for k in (("H", "a"), ("K", "b"))
+        for st in ("median", "max")
+    }
+    fig, alt = error_figure(rows, slopes)
+    labels = [t.get_text() for ax in fig.axes for t in ax.get_legend().get_texts()]
+    assert "a, median: slope 2.00" in labels and "a, max: slope 0.00" in labels
+    assert "H a 2.00 / 0.00" in alt and "regular and jittered meshes" in alt and "10 to 160 vertices" in alt

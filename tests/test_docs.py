@@ -294,3 +294,28 @@ def test_the_readme_gives_each_notebook_the_time_its_opening_block_states():
     for _, name, minutes in rows:
         stated = _stated_minutes(ROOT / "notebooks" / name)
         assert stated is None or stated == int(minutes), f"{name} says about {stated} minutes, the README {minutes}"
+
+
+def test_the_readme_names_every_exercise_in_its_notebooks_row():
+    """The "you will write" column: each exercise of geomlib.check, in the row of the notebook
+    whose grade cells hold it, and no name that is not an exercise."""
+    from geomlib import check
+
+    exercises = {name for name in dir(check) if hasattr(getattr(check, name), "evaluate")}
+    rows = re.findall(
+        r"^\| \[\d\d [^|]*\]\(notebooks/([^)]+)\)[^|]*\| ([^|]*) \|", (ROOT / "README.md").read_text(), re.M
+    )
+    named = {}
+    for notebook, written in rows:
+        for name in re.findall(r"`(\w+)`", written):
+            assert name in exercises, (
+                f"the README says {notebook} asks for {name}, which is no exercise of geomlib.check"
+            )
+            named[name] = notebook
+    graded = {}
+    for path in build_site.notebook_paths():
+        for cell in nbformat.read(path, as_version=4).cells:
+            grade_id = cell.metadata.get("nbgrader", {}).get("grade_id", "")
+            if cell.metadata.get("nbgrader", {}).get("solution") and grade_id in exercises:
+                graded[grade_id] = path.name
+    assert named == graded

@@ -24,7 +24,6 @@ def test_05_course_meshes_with_the_assignments_absolute_step():
         BREAK_MARGIN=0.3,
         BREAK_ITERATIONS=20,
         ITERATIONS=0,
-        CUBE_STEPS=1,
     )
     text, notes = run.outputs_text(), run.notes_text()
     # the conversion table: 1e-5 is 0.0278 of fandisk_ns's limit and 2.1 times plane_ns's
@@ -64,7 +63,6 @@ def test_05_one_step_per_mesh_runs_the_assignments_task_5_in_one_go():
         BREAK_MARGIN=0.3,
         BREAK_ITERATIONS=20,
         ITERATIONS=50,
-        CUBE_STEPS=1,
     )
     text, notes = run.outputs_text(), run.notes_text()
     assert "| plane | STEP = 1e-06 length^2 | 1e-06 | 0.03545 | 0.2118 |" in text
@@ -87,7 +85,6 @@ def test_05_awkward_meshes_and_the_other_ends_of_the_ranges(awkward):
         BREAK_MARGIN=0.005,
         BREAK_ITERATIONS=1000,
         ITERATIONS=1000,
-        CUBE_STEPS=50,
     )
     notes = run.notes_text()
     assert "2 connected components" in notes and "largest_component" in notes

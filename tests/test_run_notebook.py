@@ -243,13 +243,13 @@ def test_a_notebook_that_stops_is_one_sentence(error, sentence, tmp_path, monkey
 @pytest.mark.slow
 def test_a_run_with_a_changed_parameter_writes_the_notebook_and_its_page(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(rn, "RUNS", tmp_path)
-    assert rn.main(["00", "OFFSET_RANGE=2.5", "SEED=3"]) == 0
+    assert rn.main(["00", "UP=y"]) == 0
     page = Path(capsys.readouterr().out.strip().splitlines()[-1])
     assert page.parent.parent == tmp_path and page.name == "00_getting_started.html" and page.is_file()
     assert page.parent.name.startswith("00_getting_started-")
     nb = nbformat.read(page.with_suffix(".ipynb"), as_version=4)
     (injected,) = [c for c in nb.cells if "injected-parameters" in c.metadata.get("tags", [])]
-    assert "OFFSET_RANGE = 2.5" in injected.source and "SEED = 3" in injected.source
+    assert "UP = 'y'" in injected.source or 'UP = "y"' in injected.source
     assert not [o for c in nb.cells if c.cell_type == "code" for o in c.outputs if o.output_type == "error"]
     # the 3D views are live on the page: widget state saved, the renderer's script beside it
     html = page.read_text()

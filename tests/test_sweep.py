@@ -81,3 +81,20 @@ def test_bad_grids_are_refused():
         denoising_comparison(V, F, (0.01,), 1, grids={("explicit", "uniform"): ((0.5,), (0,))})
     with pytest.raises(geomlib.MeshError):
         denoising_comparison(V, F, (0.01,), 1, grids={("crank", "uniform"): ((0.5,), (1,))})
+
+
+def test_notebook_07_compares_at_the_assignment_s_noise_level():
+    """07's parameters: the comparison's noise levels contain the assignment's sigma = 0.05, the experiment's."""
+    import ast
+    from pathlib import Path
+
+    import nbformat
+
+    nb = nbformat.read(Path(__file__).resolve().parents[1] / "notebooks" / "07_denoising_evaluation.ipynb", 4)
+    (cell,) = [c for c in nb.cells if "parameters" in c.metadata.get("tags", [])]
+    values = {}
+    for node in ast.parse(cell.source).body:
+        if isinstance(node.value, ast.Constant | ast.Tuple):
+            values[node.targets[0].id] = ast.literal_eval(node.value)
+    assert values["DENOISE_SIGMA"] == 0.05 and values["DENOISE_ITERATIONS"] == 200 and values["DENOISE_STEP"] == 1e-3
+    assert values["DENOISE_SIGMA"] in values["SIGMAS"]

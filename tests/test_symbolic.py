@@ -13,7 +13,16 @@ from partials import central_partials
 from scipy.optimize import brentq
 
 from geomlib import symbolic
-from geomlib.lessons.symbolic import ellipsoid, helicoid, monge, saddle, sphere, torus
+from geomlib.lessons.symbolic import (
+    ellipsoid,
+    ellipsoid_forms,
+    ellipsoid_normal_curvature,
+    helicoid,
+    monge,
+    saddle,
+    sphere,
+    torus,
+)
 
 RNG_SEED = 20240611
 
@@ -263,10 +272,10 @@ def test_normal_curvature_at_random_points_equals_normal_section(seed):
     grad = P / np.array([a * a, b * b, c * c])
     n = grad / np.linalg.norm(grad)
     _, _, m, pu, pv = fd_forms(p, u, v, h=1e-6)
-    e1 = pu / np.linalg.norm(pu)
-    w = np.cross(m, e1)  # +90 degrees about m = p_u x p_v / |p_u x p_v|
+    t_u = pu / np.linalg.norm(pu)
+    w = np.cross(m, t_u)  # +90 degrees about m = p_u x p_v / |p_u x p_v|
     assert w @ pv > 0
-    t = np.cos(phi) * e1 + np.sin(phi) * w
+    t = np.cos(phi) * t_u + np.sin(phi) * w
     expected = section_curvature(F, P, t, n)
     got = ellipsoid(a, b, c).lambdify("normal_curvature")(u, v, phi)
     np.testing.assert_allclose(got, expected, rtol=1e-6)
@@ -289,17 +298,17 @@ def test_euler_theorem_and_principal_directions(make, urange, vrange):
     d1, d2 = S.lambdify("principal_directions")(u, v)
     n = S.lambdify("unit_normal")(u, v)
     pu = S.lambdify("p_u")(u, v)
-    e1 = pu / np.linalg.norm(pu, axis=1, keepdims=True)
+    t_u = pu / np.linalg.norm(pu, axis=1, keepdims=True)
     dot = lambda x, y: np.einsum("ij,ij->i", x, y)
     np.testing.assert_allclose(dot(d1, d1), 1, atol=1e-12)
     np.testing.assert_allclose(dot(d1, d2), 0, atol=1e-12)
     np.testing.assert_allclose(dot(d1, n), 0, atol=1e-12)
     np.testing.assert_allclose(dot(d2, n), 0, atol=1e-12)
-    # phi1: angle of d1 from p_u, measured towards w = m x e1
+    # phi1: angle of d1 from p_u, measured towards w = m x t_u
     m = np.cross(pu, S.lambdify("p_v")(u, v))
     m /= np.linalg.norm(m, axis=1, keepdims=True)
-    w = np.cross(m, e1)
-    phi1 = np.arctan2(dot(d1, w), dot(d1, e1))
+    w = np.cross(m, t_u)
+    phi1 = np.arctan2(dot(d1, w), dot(d1, t_u))
     kn = S.lambdify("normal_curvature")
     np.testing.assert_allclose(kn(u, v, phi1), k1, atol=1e-12)
     np.testing.assert_allclose(kn(u, v, phi1 + np.pi / 2), k2, atol=1e-12)
@@ -507,3 +516,52 @@ def test_unsimplified_surfaces_give_the_simplified_values(make):
     plain, simple = make(False), make(True)
     for name in ("unit_normal", "mean_curvature", "gaussian_curvature"):
         np.testing.assert_allclose(plain.lambdify(name)(u, v), simple.lambdify(name)(u, v), rtol=1e-11, atol=1e-13)
+
+
+# ------------------------- the references of notebook 02's exercises, written out
+def test_ellipsoid_forms_written_out_equal_the_structured_derivation():
+    """ellipsoid_forms derives I and II as a learner does; ellipsoid() keeps them short: the same values."""
+    a, b, c = sp.symbols("a b c", positive=True)
+    u, v = sp.symbols("u v", real=True)
+    I, II = ellipsoid_forms(a, b, c, u, v)
+    ell = ellipsoid(a, b, c)
+    args = (a, b, c, ell.u, ell.v)
+    mine = sp.lambdify((a, b, c, u, v), list(I) + list(II), "numpy")
+    library = sp.lambdify(args, list(ell.first_fundamental_form()) + list(ell.second_fundamental_form()), "numpy")
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(20):
+        point = (*rng.uniform(0.4, 2.5, 3), rng.uniform(0, 2 * np.pi), rng.uniform(0.05, np.pi - 0.05))
+        np.testing.assert_allclose(mine(*point), library(*point), rtol=1e-12, atol=1e-14)
+    # numbers for (u, v) are put in after differentiating: (a, 0, 0) gives I = diag(b^2, c^2), II = diag(a, a)
+    I0, II0 = ellipsoid_forms(a, b, c, 0, sp.pi / 2)
+    assert I0.applyfunc(sp.simplify) == sp.diag(b**2, c**2) and II0.applyfunc(sp.simplify) == sp.diag(a, a)
+
+
+def test_ellipsoid_normal_curvature_is_the_compiled_one_where_F_is_not_zero():
+    rng = np.random.default_rng(RNG_SEED + 7)
+    a, b, c = 1.3, 0.8, 0.45
+    u, v, phi = rng.uniform(0, 2 * np.pi, 200), rng.uniform(0.05, np.pi - 0.05, 200), rng.uniform(0, 2 * np.pi, 200)
+    assert np.abs(ellipsoid(a, b, c).lambdify("first_fundamental_form")(u, v)[:, 0, 1]).max() > 0.1
+    np.testing.assert_allclose(
+        ellipsoid_normal_curvature(a, b, c, phi, u, v),
+        ellipsoid(a, b, c).lambdify("normal_curvature")(u, v, phi),
+        rtol=1e-12,
+    )
+    phi = np.linspace(0, 2 * np.pi, 9)
+    np.testing.assert_allclose(
+        ellipsoid_normal_curvature(a, b, c, phi), a * np.cos(phi) ** 2 / b**2 + a * np.sin(phi) ** 2 / c**2
+    )
+
+
+def test_frame_coefficients_are_the_shape_operator_in_the_orthonormal_frame():
+    """(L11, L12, L22): the matrix of L = I^-1 II in the frame (t_u, w) is symmetric with these entries."""
+    ell = ellipsoid(1.0, 2.0, 3.0)
+    u, v = 0.7, 1.0
+    L11, L12, L22 = (float(x.subs({ell.u: u, ell.v: v})) for x in ell.frame_coefficients())
+    t_u, w = (np.array(x, dtype=float).ravel() for x in ell.frame(u, v))
+    pu, pv = ell.lambdify("p_u")(u, v), ell.lambdify("p_v")(u, v)
+    coords = np.linalg.lstsq(np.stack([pu, pv], axis=1), np.stack([t_u, w], axis=1), rcond=None)[0]
+    L = ell.lambdify("shape_operator")(u, v)  # acts on coordinate vectors (du, dv)
+    in_frame = np.linalg.solve(coords, L @ coords)
+    np.testing.assert_allclose(in_frame, [[L11, L12], [L12, L22]], atol=1e-12)
+    assert abs(L12) > 1e-3

@@ -150,6 +150,9 @@ WIDGET_RENDERER = f"{ASSETS}/html-manager/dist/embed-amd.js"
 MATHJAX = f"{ASSETS}/mathjax/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
 #: the project's own page script that moves precomputed sliders (source: tools/site_states.js)
 STATES_JS = f"{ASSETS}/site/site_states.js"
+#: the project's own page script that names the widgets, makes the 3D views keyboard-operable and
+#: announces what a slider changes (source: tools/site_a11y.js)
+A11Y_JS = f"{ASSETS}/site/site_a11y.js"
 AMD_PATHS = {
     "jupyter-threejs": f"{ASSETS}/jupyter-threejs/dist/index",
     "jupyter-datawidgets": f"{ASSETS}/jupyter-datawidgets/dist/index",
@@ -157,6 +160,47 @@ AMD_PATHS = {
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
+#: the page's accessibility style (WCAG 2.1 AA): text contrast at least 4.5:1 (the prompts
+#: and the code colours of nbconvert's theme on the cells' #f5f5f5 were 2.2 to 4.4:1), slider
+#: tracks and handles at least 3:1 against the page, labels that grow instead of cutting
+#: their text under wider spacing, a visible focus on the 3D views, the skip link
+A11Y_CSS = """
+body.jp-Notebook {
+  --jp-cell-prompt-opacity: 1; --jp-cell-prompt-not-active-opacity: 1;
+  --jp-cell-prompt-not-active-font-color: #5e5e5e; --jp-cell-inprompt-font-color: #2a6eab;
+  --jp-cell-outprompt-font-color: #b3522f;
+  --jp-mirror-editor-number-color: #007a00; --jp-mirror-editor-operator-color: #9a1ce6;
+  --jp-mirror-editor-meta-color: #9a1ce6; --jp-mirror-editor-comment-color: #3a7272;
+  --jp-mirror-editor-atom-color: #4d4df0; --jp-mirror-editor-bracket-color: #6b6b50;
+  --jp-mirror-editor-error-color: #d40000; --jp-mirror-editor-hr-color: #6b6b6b;
+  --jp-mirror-editor-quote-color: #007a00; --jp-mirror-editor-builtin-color: #007a00;
+  --jp-mirror-editor-keyword-color: #007a00;
+}
+.jupyter-widgets.widget-slider .noUi-target, .jupyter-widgets .widget-slider .noUi-target,
+.widget-slider .noUi-target { background: #8a8a8a; border-color: #6b6b6b; }
+.widget-slider .noUi-handle { border-color: #6b6b6b !important; }
+.widget-inline-hbox .widget-label { width: auto; min-width: var(--jp-widgets-inline-label-width);
+  overflow: visible; text-overflow: clip; }
+/* links in running text are told apart by more than their colour (WCAG 1.4.1) */
+body.jp-Notebook .jp-RenderedHTMLCommon a, body.jp-Notebook .jp-RenderedHTMLCommon a:link,
+body.jp-Notebook .jp-RenderedHTMLCommon a:visited { text-decoration: underline; }
+.geomlib-canvas:focus { outline: 3px solid #1a5fb4; outline-offset: 2px; }
+p.site-view-keys { font-size: 13px; color: #444; margin: 0.2em 0; }
+.site-visually-hidden { position: absolute; width: 1px; height: 1px; overflow: hidden; clip: rect(0 0 0 0);
+  white-space: nowrap; }
+"""
+#: the skip link at the top of every page: hidden until it has focus (the first Tab stop)
+SKIP_LINK = '<a class="site-skip" href="#site-content">Skip to the content</a>'
+SKIP_CSS = """a.site-skip { position: absolute; left: 0.5em; top: -3em; z-index: 10; padding: 0.4em 0.8em;
+  background: #fff; color: #0b57d0; border: 2px solid #0b57d0; }
+a.site-skip:focus { top: 0.5em; }
+main:focus { outline: none; }"""
+
+#: the visible hint after every live 3D view (tools/site_a11y.js makes these keys work)
+VIEW_KEYS = (
+    "Keys, once the 3D view has focus (Tab to it or click it): arrow keys turn it, Shift + arrow keys pan, "
+    "+ and - zoom, 0 resets. Mouse: drag to turn, wheel to zoom, right-drag to pan."
+)
 KERNEL_NOTE = "In JupyterLab this control recomputes the result; on this page it stays at its default value."
 KERNEL_NOTE_MANY = "In JupyterLab these controls recompute the result; on this page they stay at their default values."
 KERNEL_NOTE_OTHERS = (
@@ -336,6 +380,18 @@ def snap_note(sliders):
     )
 
 
+def _alt_in_output_widget(outputs):
+    """An image with an alt text in its metadata, inside an Output widget, as an ``<img>`` with that
+    alt: the widgets' renderer of the page draws a PNG output without it (the page's own
+    outputs get theirs from the template)."""
+    for output in outputs:
+        data = output.get("data", {})
+        alt = output.get("metadata", {}).get("image/png", {}).get("alt")
+        if "image/png" in data and alt:
+            src = f"data:image/png;base64,{data.pop('image/png').strip()}"
+            data["text/html"] = f'<img src="{src}" alt="{html.escape(alt)}">'
+
+
 def prepare_for_site(nb, recorded=None):
     """Make an executed notebook fit for a static page (in place); returns the live view count.
 
@@ -347,10 +403,16 @@ def prepare_for_site(nb, recorded=None):
     - an output whose widget was not saved loses its widget part, so its still
       picture (image/png) or text is shown instead;
     - a live 3D view keeps its still picture, hidden, after it: the page shows it
-      when the browser has no WebGL or the view did not appear (script in TEMPLATE).
+      when the browser has no WebGL or the view did not appear (script in TEMPLATE);
+      its alt is the view's text alternative (the output's ``image/png`` metadata);
+      a line after the view says which keys turn, zoom and reset it;
+    - a figure inside an Output widget keeps the alt text of its metadata.
     """
     recorded = recorded or {}
     state = nb.metadata.get("widgets", {}).get(WIDGET_STATE, {}).get("state", {})
+    for model in state.values():
+        if model.get("model_name") == "OutputModel":
+            _alt_in_output_widget(model.get("state", {}).get("outputs", []))
     live_sliders = {s["model_id"]: s for r in recorded.values() for s in r.get("sliders", [])}
     for mid, model in state.items():
         if _is_control(model) and mid not in live_sliders:
@@ -371,13 +433,16 @@ def prepare_for_site(nb, recorded=None):
                 continue
             renderers = sum(state[m].get("model_name") == "RendererModel" for m in models)
             live += renderers
-            if renderers and "image/png" in output["data"]:
+            if renderers and "image/png" in output["data"]:  # right after its view (the reveal script)
+                alt = output.get("metadata", {}).get("image/png", {}).get("alt") or "still picture of the 3D view"
                 outputs.append(
                     _html_output(
-                        f'<img class="site-still" hidden alt="still picture of the 3D view" '
+                        f'<img class="site-still" hidden alt="{html.escape(alt)}" '
                         f'src="data:image/png;base64,{output["data"]["image/png"].strip()}">'
                     )
                 )
+            if renderers:
+                outputs.append(_html_output(f'<p class="site-view-keys">{html.escape(VIEW_KEYS)}</p>'))
             snapping = [s for s in live_sliders.values() if s["model_id"] in models]
             if snapping:
                 outputs.append(_html_output(f'<p class="site-snap-note">{html.escape(snap_note(snapping))}</p>'))
@@ -449,7 +514,12 @@ details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 1
 /* the widget style sheets take their font from a variable only JupyterLab's own page defines */
 .jupyter-widgets, .jupyter-widgets input, .jupyter-widgets select, .jupyter-widgets button {
   font-family: var(--jp-ui-font-family); }
+%(a11y_css)s
 </style>
+<script type="text/x-mathjax-config">
+// formulas out of the Tab order (their assistive MathML stays for screen readers)
+MathJax.Hub.Config({menuSettings: {inTabOrder: false}});
+</script>
 {%- endblock html_head_js_requirejs -%}
 {%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
 {% block input_group -%}
@@ -462,11 +532,23 @@ details.site-hidden-input > summary { cursor: pointer; color: #666; font-size: 1
 {%- endif -%}
 {% endblock input_group %}
 {%- block body_header -%}
-{{ super() }}
-{{ resources.site_nav }}
+<body class="jp-Notebook" data-jp-theme-light="true" data-jp-theme-name="JupyterLab Light">
+%(skip_link)s
+<div id="site-live" class="site-visually-hidden" aria-live="polite" aria-atomic="true"></div>
+{{ resources.site_nav.replace('<nav class="site-nav"', '<nav class="site-nav" aria-label="Pages"') }}
+<main id="site-content" tabindex="-1">
 {%- endblock body_header -%}
+{% block data_png scoped %}
+{#- the alt text from the output's metadata (show_figure, the 3D views' stills); nbconvert's own template has none -#}
+{%- set alt = output | get_metadata('alt', 'image/png') -%}
+<div class="jp-RenderedImage jp-OutputArea-output {{ extra_class }}">
+<img src="data:image/png;base64,{{ output.data['image/png'] | escape_html }}"
+{%- if alt %} alt="{{ alt | escape_html }}"{% endif %}>
+</div>
+{%- endblock data_png %}
 {% block body_footer %}
-{{ resources.site_nav.replace('class="site-nav"', 'class="site-nav bottom"') }}
+</main>
+{{ resources.site_nav.replace('<nav class="site-nav"', '<nav class="site-nav bottom" aria-label="Pages (end of page)"') }}
 <script>
 // buffers the build saved once (share_repeated_buffers) are copied back into the widget
 // state before the widget manager reads it (it renders on "load", after this)
@@ -488,6 +570,7 @@ document.addEventListener("DOMContentLoaded", function () {
 <script type="application/json" id="site-states">{{ resources.site_states }}</script>
 <script src="%(states_js)s"></script>
 {%- endif %}
+<script src="%(a11y_js)s"></script>
 <script>
 // the still picture of a 3D view replaces nothing; it appears below the view when
 // the browser has no WebGL, or when the view has drawn no canvas 30 s after loading
@@ -513,7 +596,7 @@ document.addEventListener("DOMContentLoaded", function () {
   }
 })();
 </script>
-{{ super() }}
+</body>
 {% endblock body_footer %}
 """
 
@@ -522,7 +605,13 @@ def exporter():
     from jinja2 import DictLoader
     from nbconvert import HTMLExporter
 
-    template = TEMPLATE.replace("%(paths)s", json.dumps(AMD_PATHS)).replace("%(states_js)s", STATES_JS)
+    template = (
+        TEMPLATE.replace("%(paths)s", json.dumps(AMD_PATHS))
+        .replace("%(states_js)s", STATES_JS)
+        .replace("%(a11y_js)s", A11Y_JS)
+        .replace("%(skip_link)s", SKIP_LINK)
+        .replace("%(a11y_css)s", A11Y_CSS + SKIP_CSS)
+    )
     return HTMLExporter(
         extra_loaders=[DictLoader({"site.html.j2": template})],
         template_file="site.html.j2",
@@ -600,7 +689,7 @@ def markdown_notebook(source, targets):
 
 # a documentation page is mostly links in running text: underlined, so that they are told
 # apart from the text by more than their colour (WCAG 1.4.1)
-DOC_CSS = ".jp-RenderedMarkdown a { text-decoration: underline; }"
+DOC_CSS = ".jp-RenderedMarkdown a:link, .jp-RenderedMarkdown a:visited { text-decoration: underline; }"
 
 # the site's navigation bars on pdoc's page (the notebooks' pages style them in TEMPLATE)
 REFERENCE_NAV_CSS = """nav.site-nav { display: flex; justify-content: space-between; gap: 1em; padding: 0.6em 1em;
@@ -631,12 +720,15 @@ def reference_html(nav):
         lambda m: f'<a class="headerlink" href="#{m[1]}" aria-label="link to {m[1]}"></a>',
         page,
     )
-    style = f"<style>{REFERENCE_NAV_CSS}</style>"
+    style = f"<style>{REFERENCE_NAV_CSS}\n{SKIP_CSS}</style>"
     # inside pdoc's main column: its module list is a fixed column on the left of a wide window
-    bottom = nav.replace('class="site-nav"', 'class="site-nav bottom"')
+    top = nav.replace('<nav class="site-nav"', '<nav class="site-nav" aria-label="Pages"')
+    bottom = nav.replace('<nav class="site-nav"', '<nav class="site-nav bottom" aria-label="Pages (end of page)"')
+    page = re.sub(r"(<body[^>]*>)", lambda m: m[1] + "\n" + SKIP_LINK, page, count=1)
+    page = page.replace('<nav class="pdoc">', '<nav class="pdoc" aria-label="Contents of the reference">', 1)
     return (
         page.replace("</head>", style + "\n</head>", 1)
-        .replace('<main class="pdoc">', '<main class="pdoc">\n' + nav, 1)
+        .replace('<main class="pdoc">', '<main class="pdoc" id="site-content" tabindex="-1">\n' + top, 1)
         .replace("</main>", bottom + "\n</main>", 1)
     )
 
@@ -662,6 +754,8 @@ def write_page(nb, out, name):
     body, _ = exporter().from_notebook_node(nb, resources={"site_nav": "", "metadata": {"name": title_of(nb, name)}})
     page = out / f"{name}.html"
     page.write_text(body, encoding="utf-8")
+    (out / A11Y_JS).parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(Path(__file__).with_name("site_a11y.js"), out / A11Y_JS)
     return page
 
 
@@ -672,9 +766,12 @@ INDEX = """<!DOCTYPE html>
 <style>
 body {{ font-family: system-ui, sans-serif; max-width: 50em; margin: 2em auto; padding: 0 1em; line-height: 1.5; }}
 li {{ margin: 0.4em 0; }}
-.views {{ color: #666; font-size: 0.9em; }}
+.views {{ color: #595959; font-size: 0.9em; }}
+{skip_css}
 </style></head>
 <body>
+{skip_link}
+<main id="site-content" tabindex="-1">
 <h1>{title}</h1>
 <p>Every notebook of the workbook, run with its default parameters. The 3D views
 turn in the page: drag to orbit, scroll to zoom, right-drag to pan. The main
@@ -689,6 +786,7 @@ geomlib's public functions with their docstrings.</p>
 <ul>
 {documents}
 </ul>
+</main>
 </body>
 </html>
 """
@@ -713,6 +811,7 @@ def build(out=OUT, names=None, log=print):
     install_assets(out)
     (out / STATES_JS).parent.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(Path(__file__).with_name("site_states.js"), out / STATES_JS)
+    shutil.copyfile(Path(__file__).with_name("site_a11y.js"), out / A11Y_JS)
     pages = []
     executed = []
     for path in paths:
@@ -790,7 +889,13 @@ def build(out=OUT, names=None, log=print):
         if p["kind"] in ("doc", "reference")
     )
     (out / "index.html").write_text(
-        INDEX.format(title="Discrete curvature and Laplacian mesh processing", items=items, documents=documents),
+        INDEX.format(
+            title="Discrete curvature and Laplacian mesh processing",
+            items=items,
+            documents=documents,
+            skip_link=SKIP_LINK,
+            skip_css=SKIP_CSS,
+        ),
         encoding="utf-8",
     )
     (out / "pages.json").write_text(json.dumps(pages, indent=1))

@@ -593,9 +593,9 @@ def implicit_smoothing(
     rebuild : bool
         False (default): the operator of V is kept and factorised once. True: M
         and C are rebuilt from the current positions every iteration (implicit
-        mean curvature flow); as the surface shrinks triangles degenerate and
-        the mesh can collapse: then the run stops (see ``on_failure``) instead
-        of returning a NaN mesh.
+        mean curvature flow); as the surface shrinks its area goes to zero (a
+        non-convex one may pinch off first) and triangles degenerate: then the
+        run stops (see ``on_failure``) instead of returning a NaN mesh.
     keep_volume : bool
         After every iteration rescale about the centroid of the enclosed solid
         so that volume and centroid stay those of V (the volume rescaling of

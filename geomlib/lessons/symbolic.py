@@ -8,22 +8,22 @@ Sign convention (the same as the discrete one in the rest of geomlib, where
   documents (``n = p_u x p_v / |p_u x p_v|`` unless stated, so the upward
   normal ``(-h_x, -h_y, 1) / sqrt(1 + h_x^2 + h_y^2)`` of a Monge patch
   ``z = h(x, y)``).
-* The second fundamental form uses the opposite normal ``N = -n``:
-  ``e = p_uu . N``, ``f = p_uv . N``, ``g = p_vv . N``. A surface that bends
+* The second fundamental form uses the opposite normal ``-n``:
+  ``e = -p_uu . n``, ``f = -p_uv . n``, ``g = -p_vv . n``. A surface that bends
   away from ``n`` (a sphere seen from outside) therefore has positive normal
   curvature: a sphere of radius r has every normal curvature ``+1/r``,
   ``H = 1/r`` and ``K = 1/r^2``. For the ellipsoid and sphere parameterised as
   ``(a cos u sin v, b sin u sin v, c cos v)`` the vector ``p_u x p_v`` points
-  inward, so there ``N = p_u x p_v / |p_u x p_v|``, the normal of do Carmo
+  inward, so there ``-n = p_u x p_v / |p_u x p_v|``, the normal of do Carmo
   (1976, section 3-2), and his formulas hold unchanged.
 
 Definitions (all pointwise, in 1/length for curvatures, 1/length^2 for K)::
 
     I  = [[E, F], [F, G]],   E = p_u.p_u, F = p_u.p_v, G = p_v.p_v
-    II = [[e, f], [f, g]]    (normal N = -n as above)
-    S  = I^-1 II             shape operator on coordinate vectors (du, dv)
-    K  = det II / det I = k1 k2,      H = tr S / 2 = (k1 + k2) / 2
-    k1 >= k2                 principal curvatures, eigenvalues of S
+    II = [[e, f], [f, g]]    (with the normal -n, as above)
+    L  = I^-1 II             shape operator on coordinate vectors (du, dv)
+    K  = det II / det I = k1 k2,      H = tr L / 2 = (k1 + k2) / 2
+    k1 >= k2                 principal curvatures, eigenvalues of L
 
 Tangent directions are given by an angle ``phi`` measured from ``p_u`` in the
 tangent plane: the unit direction is
@@ -84,7 +84,7 @@ LAMBDIFY_NAMES = {
     "unit_normal": "(..., 3) unit normal n (outward on closed surfaces)",
     "first_fundamental_form": "(..., 2, 2) [[E, F], [F, G]]",
     "second_fundamental_form": "(..., 2, 2) [[e, f], [f, g]] with normal -n",
-    "shape_operator": "(..., 2, 2) S = I^-1 II",
+    "shape_operator": "(..., 2, 2) L = I^-1 II",
     "area_element": "(...,) sqrt(EG - F^2)",
     "gaussian_curvature": "(...,) K in 1/length^2",
     "mean_curvature": "(...,) H in 1/length (H = 1/r on a sphere)",
@@ -397,30 +397,30 @@ class ParametricSurface:
         return af * sp.sqrt(DD)
 
     def derive_frame(self):
-        """(e1, w) = (p_u/|p_u|, (E p_v - F p_u) / (sqrt(E) sqrt(EG - F^2)))."""
+        """(t_u, w) = (p_u/|p_u|, (E p_v - F p_u) / (sqrt(E) sqrt(EG - F^2)))."""
         pu, pv = self.tangents()
         I = self.first_fundamental_form()
         E, F = I[0, 0], I[0, 1]
         _, DD, af = self._normal_parts()
-        e1 = pu / sp.sqrt(E)
+        t_u = pu / sp.sqrt(E)
         wn = (E * pv - F * pu).applyfunc(lambda x: self._simplified(sp.cancel(x / af)))
-        return (e1, wn / (sp.sqrt(E) * sp.sqrt(DD)))
+        return (t_u, wn / (sp.sqrt(E) * sp.sqrt(DD)))
 
     def derive_frame_coefficients(self):
-        """(A, B, C): the second form in the orthonormal frame (p_u/|p_u|, w).
+        """(L11, L12, L22): the shape operator L (= II) in the orthonormal frame (p_u/|p_u|, w).
 
-        kappa_n(phi) = A cos^2 phi + 2 B sin phi cos phi + C sin^2 phi, with
-        A = e/E, B = (fE - eF)/(E sqrt(EG - F^2)), C = (eF^2 - 2fFE + gE^2)/(E (EG - F^2)).
+        kappa_n(phi) = L11 cos^2 phi + 2 L12 sin phi cos phi + L22 sin^2 phi, with
+        L11 = e/E, L12 = (fE - eF)/(E sqrt(EG - F^2)), L22 = (eF^2 - 2fFE + gE^2)/(E (EG - F^2)).
         """
         en, fn, gn = self._second_numerators()
         _, DD, af = self._normal_parts()
         I = self.first_fundamental_form()
         E, F = I[0, 0], I[0, 1]
         W = sp.sqrt(DD)
-        A = self._simplified(sp.cancel(en / E)) / W
-        B = self._simplified(sp.cancel((fn * E - en * F) / (E * af))) / DD
-        C = self._simplified(sp.cancel((en * F**2 - 2 * fn * F * E + gn * E**2) / (E * af**2))) / W**3
-        return (A, B, C)
+        L11 = self._simplified(sp.cancel(en / E)) / W
+        L12 = self._simplified(sp.cancel((fn * E - en * F) / (E * af))) / DD
+        L22 = self._simplified(sp.cancel((en * F**2 - 2 * fn * F * E + gn * E**2) / (E * af**2))) / W**3
+        return (L11, L12, L22)
 
     # ------------------------------------------------------ public, symbolic
     def tangents(self):
@@ -445,14 +445,14 @@ class ParametricSurface:
         return self._get("unit_normal", self.derive_unit_normal)
 
     def second_fundamental_form(self):
-        """II = [[e, f], [f, g]] with e = p_uu . N, N = -unit_normal() (length), 2x2 sympy Matrix.
+        """II = [[e, f], [f, g]] with e = -p_uu . n, n = unit_normal() (length), 2x2 sympy Matrix.
 
         Positive on a sphere / ellipsoid: a sphere of radius r has II = I / r.
         """
         return self._get("second_fundamental_form", self.derive_second_fundamental_form)
 
     def shape_operator(self):
-        """S = I^-1 II (1/length), acting on coordinate vectors (du, dv); eigenvalues k1, k2."""
+        """L = I^-1 II (1/length), acting on coordinate vectors (du, dv); eigenvalues k1, k2."""
         return self._get("shape_operator", self.derive_shape_operator)
 
     def area_element(self):
@@ -468,9 +468,9 @@ class ParametricSurface:
         return self._get("mean_curvature", self.derive_mean_curvature)
 
     def frame_coefficients(self):
-        """(A, B, C) with kappa_n(phi) = A cos^2 phi + 2 B sin phi cos phi + C sin^2 phi (1/length).
+        """(L11, L12, L22) with kappa_n(phi) = L11 cos^2 phi + 2 L12 sin phi cos phi + L22 sin^2 phi (1/length).
 
-        A = kappa_n(0) (direction p_u), C = kappa_n(pi/2), B the twist; the
+        L11 = kappa_n(0) (direction p_u), L22 = kappa_n(pi/2), L12 the twist; the
         second fundamental form written in the orthonormal frame (p_u/|p_u|, w).
         """
         return self._get("frame_coefficients", self.derive_frame_coefficients)
@@ -510,9 +510,9 @@ class ParametricSurface:
         the surface's symbols. Positive where the surface bends away from the
         unit normal n (a sphere of radius r: 1/r for every phi).
         """
-        A, B, C = self._point("frame_coefficients", u, v)
+        L11, L12, L22 = self._point("frame_coefficients", u, v)
         phi = sp.sympify(phi)
-        expr = A * sp.cos(phi) ** 2 + 2 * B * sp.sin(phi) * sp.cos(phi) + C * sp.sin(phi) ** 2
+        expr = L11 * sp.cos(phi) ** 2 + 2 * L12 * sp.sin(phi) * sp.cos(phi) + L22 * sp.sin(phi) ** 2
         if u is None and v is None:
             return expr
         return _tidy(expr)
@@ -521,27 +521,27 @@ class ParametricSurface:
         """(k1, k2), k1 >= k2: H +- sqrt(H^2 - K) (1/length), at (u, v) or as functions of u, v.
 
         At a point the values are computed from the frame coefficients:
-        H = (A + C)/2, sqrt(H^2 - K) = sqrt(((A - C)/2)^2 + B^2).
+        H = (L11 + L22)/2, sqrt(H^2 - K) = sqrt(((L11 - L22)/2)^2 + L12^2).
         """
         if u is None and v is None:
             return self._get("principal_curvatures", self.derive_principal_curvatures)
-        A, B, C = self._point("frame_coefficients", u, v)
-        H = _tidy((A + C) / 2)
-        R = _tidy(sp.sqrt(((A - C) / 2) ** 2 + B**2))
+        L11, L12, L22 = self._point("frame_coefficients", u, v)
+        H = _tidy((L11 + L22) / 2)
+        R = _tidy(sp.sqrt(((L11 - L22) / 2) ** 2 + L12**2))
         return (_tidy(H + R), _tidy(H - R))
 
     def principal_directions(self, u, v):
         """Principal directions at (u, v): ((phi1, d1), (phi2, d2)) for k1 >= k2.
 
-        phi1 = atan2(2B, A - C) / 2 in the frame (p_u/|p_u|, w), phi2 = phi1 -+ pi/2
+        phi1 = atan2(2 L12, L11 - L22) / 2 in the frame (p_u/|p_u|, w), phi2 = phi1 -+ pi/2
         (both angles in (-pi/2, pi/2]);
         d1, d2 are unit 3-vectors (3x1 sympy matrices). At an umbilic
-        (A = C, B = 0) every direction is principal and phi1 = 0 is returned.
+        (L11 = L22, L12 = 0) every direction is principal and phi1 = 0 is returned.
         """
-        A, B, C = self._point("frame_coefficients", u, v)
-        diff = _tidy(A - C)
-        if _tidy(B) == 0:
-            # the frame is principal; which of e1, w has the larger curvature?
+        L11, L12, L22 = self._point("frame_coefficients", u, v)
+        diff = _tidy(L11 - L22)
+        if _tidy(L12) == 0:
+            # the frame is principal; which of t_u, w has the larger curvature?
             if diff.is_nonnegative:
                 phi1 = sp.Integer(0)
             elif diff.is_negative:
@@ -549,7 +549,7 @@ class ParametricSurface:
             else:
                 phi1 = sp.Piecewise((sp.Integer(0), diff >= 0), (sp.pi / 2, True))
         else:
-            phi1 = _tidy(sp.atan2(2 * B, diff) / 2)
+            phi1 = _tidy(sp.atan2(2 * L12, diff) / 2)
         # the second direction at phi1 -+ pi/2, whichever lies in (-pi/2, pi/2]
         if isinstance(phi1, sp.Piecewise):
             phi2 = sp.Piecewise((sp.pi / 2, diff >= 0), (sp.Integer(0), True))
@@ -559,17 +559,17 @@ class ParametricSurface:
                 phi2 = phi1 + sp.pi / 2 if nonpositive == sp.true else phi1 - sp.pi / 2
             else:
                 phi2 = sp.Piecewise((phi1 + sp.pi / 2, nonpositive), (phi1 - sp.pi / 2, True))
-        e1, w = self.frame(u, v)
+        t_u, w = self.frame(u, v)
         out = []
         for phi in (phi1, phi2):
-            d = (sp.cos(phi) * e1 + sp.sin(phi) * w).applyfunc(_tidy)
+            d = (sp.cos(phi) * t_u + sp.sin(phi) * w).applyfunc(_tidy)
             out.append((_tidy(phi), d))
         return tuple(out)
 
     def frame(self, u=None, v=None):
-        """(e1, w): the orthonormal tangent frame phi is measured in (3x1 sympy matrices).
+        """(t_u, w): the orthonormal tangent frame phi is measured in (3x1 sympy matrices).
 
-        e1 = p_u/|p_u|; w = m x e1 with m = p_u x p_v / |p_u x p_v|, i.e. the unit
+        t_u = p_u/|p_u|; w = m x t_u with m = p_u x p_v / |p_u x p_v|, i.e. the unit
         tangent perpendicular to p_u on the side of p_v.
         """
         return self._point("frame", u, v)
@@ -596,8 +596,8 @@ class ParametricSurface:
         if name == "frame_coefficients":
             return list(fam.frame_coefficients())
         if name == "frame":
-            e1, w = fam.frame()
-            return list(e1) + list(w)
+            t_u, w = fam.frame()
+            return list(t_u) + list(w)
         raise ValueError(f"unknown quantity {name!r}; lambdify knows {sorted(LAMBDIFY_NAMES)}")
 
     def _compiled(self, name):
@@ -666,9 +666,9 @@ class ParametricSurface:
         elif name == "principal_curvatures":
 
             def f(u, v, *rest):
-                (A, B, C), _ = evaluate("frame_coefficients", u, v, rest)
-                H = 0.5 * (A + C)
-                R = np.hypot(0.5 * (A - C), B)
+                (L11, L12, L22), _ = evaluate("frame_coefficients", u, v, rest)
+                H = 0.5 * (L11 + L22)
+                R = np.hypot(0.5 * (L11 - L22), L12)
                 return H + R, H - R
         elif name == "principal_directions":
 
@@ -689,21 +689,21 @@ class ParametricSurface:
                     up = evaluate("area_element", u[bad], v[bad] + step, rest)[0][0]
                     down = evaluate("area_element", u[bad], v[bad] - step, rest)[0][0]
                     v[bad] = np.where(np.abs(up) >= np.abs(down), v[bad] + step, v[bad] - step)
-                (A, B, C), _ = evaluate("frame_coefficients", u, v, rest)
+                (L11, L12, L22), _ = evaluate("frame_coefficients", u, v, rest)
                 comps, _ = evaluate("frame", u, v, rest)
-                e1 = np.stack(comps[:3], axis=-1)
+                t_u = np.stack(comps[:3], axis=-1)
                 w = np.stack(comps[3:], axis=-1)
-                phi1 = 0.5 * np.arctan2(2 * B, A - C)[..., None]
-                d1 = np.cos(phi1) * e1 + np.sin(phi1) * w
-                d2 = -np.sin(phi1) * e1 + np.cos(phi1) * w
+                phi1 = 0.5 * np.arctan2(2 * L12, L11 - L22)[..., None]
+                d1 = np.cos(phi1) * t_u + np.sin(phi1) * w
+                d2 = -np.sin(phi1) * t_u + np.cos(phi1) * w
                 return d1, d2
         else:  # normal_curvature
 
             def f(u, v, phi, *rest):
-                (A, B, C), _ = evaluate("frame_coefficients", u, v, rest)
+                (L11, L12, L22), _ = evaluate("frame_coefficients", u, v, rest)
                 phi = np.asarray(phi, dtype=float)
                 c, s = np.cos(phi), np.sin(phi)
-                return A * c * c + 2 * B * s * c + C * s * s
+                return L11 * c * c + 2 * L12 * s * c + L22 * s * s
 
         f.__name__ = name
         f.__doc__ = f"{name} of {self!r}: {LAMBDIFY_NAMES[name]}"
@@ -776,25 +776,45 @@ def ellipsoid(a, b, c, simplify=True):
 
 
 def ellipsoid_forms(a, b, c, u, v):
-    """(I, II) of ``ellipsoid(a, b, c)`` at (u, v): two 2x2 sympy matrices.
+    """(I, II) of the ellipsoid p(u, v) = (a cos u sin v, b sin u sin v, c cos v): two 2x2 sympy matrices.
 
-    I = [[E, F], [F, G]] in length^2, II = [[e, f], [f, g]] in length with the
-    inward normal N = p_u x p_v / |p_u x p_v| (module docstring). ``a, b, c, u, v``
-    are numbers or sympy symbols: the reference of the exercise of notebook 02.
+    The derivation of notebook 02 written out, as a learner writes it (the
+    reference of its exercise): I = [[E, F], [F, G]] in length^2 from the
+    tangents, II = [[e, f], [f, g]] in length from the second derivatives and
+    the unit normal p_u x p_v / |p_u x p_v|, which on this parameterisation is
+    the inward normal -n (module docstring). ``a, b, c, u, v`` are numbers or
+    sympy symbols; nothing is simplified. ``ellipsoid(a, b, c)`` derives the
+    same forms, kept short for the general ellipsoid.
     """
-    ell = ellipsoid(a, b, c)
-    at = {ell.u: u, ell.v: v}
-    return ell.first_fundamental_form().subs(at), ell.second_fundamental_form().subs(at)
+    s, t = sp.symbols("u v", real=True)  # differentiate in symbols, then put (u, v) in: they may be numbers
+    p = sp.Matrix([a * sp.cos(s) * sp.sin(t), b * sp.sin(s) * sp.sin(t), c * sp.cos(t)])
+    p_u, p_v = p.diff(s), p.diff(t)
+    m = p_u.cross(p_v)
+    minus_n = m / sp.sqrt(m.dot(m))
+    I = sp.Matrix([[p_u.dot(p_u), p_u.dot(p_v)], [p_v.dot(p_u), p_v.dot(p_v)]])
+    p_uu, p_uv, p_vv = p.diff(s, s), p.diff(s, t), p.diff(t, t)
+    II = sp.Matrix([[p_uu.dot(minus_n), p_uv.dot(minus_n)], [p_uv.dot(minus_n), p_vv.dot(minus_n)]])
+    at = {s: sp.sympify(u), t: sp.sympify(v)}
+    return I.subs(at, simultaneous=True), II.subs(at, simultaneous=True)
 
 
 def ellipsoid_normal_curvature(a, b, c, phi, u=0.0, v=math.pi / 2):
-    """kappa_n(phi) of ``ellipsoid(a, b, c)`` at (u, v), by default the point (a, 0, 0), in 1/length.
+    """kappa_n(phi) = II(t, t) of ``ellipsoid(a, b, c)`` at (u, v), by default the point (a, 0, 0), in 1/length.
 
-    ``phi`` in radians from p_u (module docstring); numbers or numpy arrays in,
-    float64 out (a compiled function of the family, so many calls are cheap).
-    At (a, 0, 0) it is ``a cos^2 phi / b^2 + a sin^2 phi / c^2``.
+    ``t`` is the unit tangent at angle ``phi`` (radians) from p_u, towards p_v
+    (module docstring), written in coordinates (du, dv): t = du p_u + dv p_v with
+    I(t, t) = 1. At (a, 0, 0), I = diag(b^2, c^2), II = diag(a, a) and
+    (du, dv) = (cos phi / b, sin phi / c), so kappa_n = a cos^2 phi / b^2 + a sin^2 phi / c^2.
+    Numbers or numpy arrays in, float64 out (the forms are compiled once per family).
     """
-    return ellipsoid(a, b, c).lambdify("normal_curvature")(u, v, phi)
+    ell = ellipsoid(a, b, c)
+    I, II = ell.lambdify("first_fundamental_form")(u, v), ell.lambdify("second_fundamental_form")(u, v)
+    E, F, G = I[..., 0, 0], I[..., 0, 1], I[..., 1, 1]
+    root_E, area = np.sqrt(E), np.sqrt(E * G - F**2)
+    # t = cos phi p_u / |p_u| + sin phi w, with w = (E p_v - F p_u) / (sqrt(E) area) the unit tangent normal to p_u
+    du = np.cos(phi) / root_E - np.sin(phi) * F / (root_E * area)
+    dv = np.sin(phi) * root_E / area
+    return II[..., 0, 0] * du**2 + 2 * II[..., 0, 1] * du * dv + II[..., 1, 1] * dv**2
 
 
 @functools.lru_cache(maxsize=None)

@@ -14,6 +14,12 @@ __all__ = ["error_figure", "error_alt"]
 MARKERS = ("o", "s", "^", "D", "v")
 
 
+def _slope(p):
+    """A slope to two decimals, without a minus sign on zero."""
+    text = f"{p:.2f}"
+    return "0.00" if text == "-0.00" else text
+
+
 def _keys(results):
     first = next(iter(results.values()))[0]
     return [k for k in first if isinstance(k, tuple)]
@@ -41,7 +47,7 @@ def error_figure(results, slopes):
                         marker=MARKERS[m % len(MARKERS)],
                         color=f"C{m}",
                         mfc="white" if i else None,
-                        label=f"{key[1]}, {stat}: slope {slopes[family, key, stat]:.2f}",
+                        label=f"{key[1]}, {stat}: slope {_slope(slopes[family, key, stat])}",
                     )
             ax.loglog(ell, 1e-2 * (ell / ell[0]) ** 2, "k:", lw=1, label="slope 2, for reference")
             ax.set(title=f"{q}, {family} meshes", ylabel="relative error")
@@ -60,7 +66,7 @@ def error_alt(results, slopes):
     parts = []
     for stat in ("median", "max"):
         per_key = "; ".join(
-            f"{q} {name} " + " / ".join(f"{slopes[f, (q, name), stat]:.2f}" for f in families) for q, name in keys
+            f"{q} {name} " + " / ".join(_slope(slopes[f, (q, name), stat]) for f in families) for q, name in keys
         )
         parts.append(
             f"slopes of the {'median' if stat == 'median' else 'maximum'} error ({' / '.join(families)}): {per_key}"
@@ -69,7 +75,7 @@ def error_alt(results, slopes):
     size = f" over meshes of {n[0]} to {n[-1]} vertices" if n else ""
     return (
         f"Log-log plots of the relative error of each curvature estimate against the mean edge length{size}, "
-        f"median (solid) and maximum (dashed), for {', '.join(families)} meshes, with a dotted line of slope 2. "
+        f"median (solid) and maximum (dashed), for {' and '.join(families)} meshes, with a dotted line of slope 2. "
         + ". ".join(parts)
         + "."
     )

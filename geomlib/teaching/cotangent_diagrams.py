@@ -105,7 +105,7 @@ def _draw_edges(ax, V, F, **style):
         ax.plot(xy[:, 0], xy[:, 1], **{"color": "0.35", "lw": 0.8, **style})
 
 
-def hat_figure(jitter=0.25, seed=4):
+def hat_figure(jitter=0.25, seed=1):
     """(fig, alt): the hat psi_i as a tent, its gradient per triangle, and an edge ij with alpha_ij, beta_ij."""
     import matplotlib.pyplot as plt
 
@@ -124,7 +124,7 @@ def hat_figure(jitter=0.25, seed=4):
     ax = fig.add_subplot(1, 3, 2)
     _draw_edges(ax, V, F[faces])
     centre = V[F[faces]].mean(axis=1)
-    scale = 0.25 / np.linalg.norm(grad, axis=1).max()
+    scale = 0.18 / np.linalg.norm(grad, axis=1).max()  # the longest arrow shorter than the triangles are apart
     ax.quiver(
         centre[:, 0],
         centre[:, 1],
@@ -154,10 +154,14 @@ def hat_figure(jitter=0.25, seed=4):
         angles.append(np.degrees(np.arctan2(np.linalg.norm(np.cross(u, w)), u @ w)))
         toward = (V[i] + V[j]) / 2 - V[k]
         ax.annotate(f"${name}$", V[k, :2] + 0.28 * toward[:2], fontsize=13, ha="center", va="center")
+    middle = V[[i, j] + third, :2].mean(axis=0)
     for name, v in (("i", i), ("j", j), ("k", third[0]), ("l", third[1])):
-        ax.annotate(name, V[v, :2], xytext=(5, 5), textcoords="offset points", fontsize=12)
+        away = V[v, :2] - middle  # each label just outside its corner
+        away = 12 * away / np.linalg.norm(away)
+        ax.annotate(name, V[v, :2], xytext=away, textcoords="offset points", fontsize=12, ha="center", va="center")
     C_ij = 0.5 * sum(1 / np.tan(np.radians(a)) for a in angles)
-    ax.set(title=f"(c) edge ij (thick), C_ij = {C_ij:.3f}", aspect="equal")
+    ax.set_title(f"(c) edge ij (thick), C_ij = {C_ij:.3f}", pad=16)
+    ax.set_aspect("equal")
     ax.axis("off")
     fig.tight_layout()
     lengths = np.linalg.norm(grad, axis=1)

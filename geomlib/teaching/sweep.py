@@ -580,7 +580,7 @@ def plot_comparison(result, i, key="rms"):
         found.append(f"{method} {weights} {b[key]:.3g} at {b['fraction']:g} of the limit, {b['iterations']} iterations")
     axes[0, 0].set_ylabel("step / explicit limit")
     fig.colorbar(im, ax=axes, label=f"{key} / noisy input's (log scale)" if noisy > 0 else key, shrink=0.9)
-    fig.suptitle(f"noise sigma = {result.sigmas[i]:g}: error after smoothing over step and iterations")
+    fig.suptitle(f"noise sigma = {result.sigmas[i]:g}: error after smoothing over step and iterations", y=1.04)
     alt = (
         f"{len(result.methods)} heat maps at noise sigma {result.sigmas[i]:g}, one per method, of the vertex "
         f"error over the step (as a fraction of the explicit limit) and the iteration count, relative to the "

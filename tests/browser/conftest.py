@@ -10,6 +10,7 @@ Without /usr/bin/chromium the tests are skipped with a message saying how to
 enable them, except on CI (environment variable CI set), where they fail.
 """
 
+import json
 import os
 import shutil
 import sys
@@ -65,6 +66,25 @@ def lab_server(browser):
         yield server
     finally:
         server.stop()
+
+
+@pytest.fixture(scope="session")
+def site(browser, tmp_path_factory):
+    """The website, built once per session for every test that opens it (test_site.py,
+    test_accessibility.py): (folder, {page file: its entry of pages.json}). GEOMLIB_SITE_DIR
+    names a folder built by ``python3 workbook.py site`` to use instead."""
+    sys.path.insert(0, str(ROOT / "tools"))
+    import build_site
+
+    given = os.environ.get("GEOMLIB_SITE_DIR")
+    if given:
+        folder = Path(given)
+        assert (folder / "pages.json").exists(), f"GEOMLIB_SITE_DIR={given} holds no built site"
+    else:
+        folder = tmp_path_factory.mktemp("site")
+        build_site.build(folder)
+    pages = {p["file"]: p for p in json.loads((folder / "pages.json").read_text())}
+    return folder, pages
 
 
 @pytest.fixture

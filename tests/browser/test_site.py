@@ -40,8 +40,6 @@ Screenshots: build/screenshots/site/.
 
 import functools
 import http.server
-import json
-import os
 import re
 import sys
 import threading
@@ -72,19 +70,6 @@ LIVE_SLIDERS = {
     "06_implicit_smoothing.html": {"τ / ℓ²", "iterations"},
     "07_denoising_evaluation.html": {"sigma", "iterations"},
 }
-
-
-@pytest.fixture(scope="session")
-def site(browser, tmp_path_factory):
-    given = os.environ.get("GEOMLIB_SITE_DIR")
-    if given:
-        folder = Path(given)
-        assert (folder / "pages.json").exists(), f"GEOMLIB_SITE_DIR={given} holds no built site"
-    else:
-        folder = tmp_path_factory.mktemp("site")
-        build_site.build(folder)
-    pages = {p["file"]: p for p in json.loads((folder / "pages.json").read_text())}
-    return folder, pages
 
 
 @pytest.fixture(scope="session")

@@ -140,6 +140,18 @@ def _check_cotangent_C(C, C_ref, V, F, label):
             "the cotangent of the wrong angle is used: an angle at i or j, an end of the edge ij",
             "use the two angles opposite the edge ij, at the third corner of each triangle",
         )
+    for A in (barycentric_areas(V, F), laplace.mixed_areas(V, F)):
+        if close(C, C_ref / A[:, None]):
+            raise Mistake(
+                "C is already divided by the vertex areas: that is M^-1 C (the operator Delta), not C",
+                "keep C_ij = 1/2 (cot alpha_ij + cot beta_ij) and put the areas in M",
+            )
+    uniform = (C_ref != 0).astype(float)
+    if close(C[off], uniform[off]):
+        raise Mistake(
+            "these are the uniform weights (1 for every edge), not the cotangent weights",
+            "C_ij = 1/2 (cot alpha_ij + cot beta_ij), from the two angles opposite the edge ij",
+        )
     tan = _weights(V, F, lambda p, q, r: r, of=lambda cot: 1.0 / cot)
     if close(C[off], tan[off]) or close(C[off], -tan[off]):
         raise Mistake("tan is used instead of cot", "cot theta = cos theta / sin theta = 1 / tan theta")

@@ -15,9 +15,9 @@ from .result import Mistake, call, close, exercise
 
 __all__ = ["explicit_step", "explicit_step_limit", "smoothing_loop"]
 
-_REREAD_STEP = "section 2 · Discretised in space and time"
-_REREAD_LIMIT = "section 3 · Why the step has a limit"
-_REREAD_LOOP = "section 4 · The smoothing loop, boundary held"
+_REREAD_STEP = "section 1 · The heat flow, one explicit step at a time"
+_REREAD_LIMIT = "section 2 · Why the step has a limit"
+_REREAD_LOOP = "section 3 · The smoothing loop, boundary held"
 
 # a tetrahedron with unequal faces (so M is not a multiple of I) and a small
 # ellipsoid scaled by 3 (so the eigenvalues of C and of M^-1 C differ by far)

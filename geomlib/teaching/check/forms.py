@@ -80,9 +80,11 @@ def _reference(points):
     p_vv = np.stack([-a * cu * sv, -b * su * sv, -c * cv], axis=1)
     m = np.cross(p_u, p_v)
     cross = np.linalg.norm(m, axis=1)
-    N = m / cross[:, None]  # inward on this parameterisation: the workbook's II
+    minus_n = m / cross[:, None]  # the inward normal -n on this parameterisation: the workbook's II
     dot = lambda x, y: np.einsum("ij,ij->i", x, y)
-    ref = np.array([dot(p_u, p_u), dot(p_u, p_v), dot(p_v, p_v), dot(p_uu, N), dot(p_uv, N), dot(p_vv, N)])
+    ref = np.array(
+        [dot(p_u, p_u), dot(p_u, p_v), dot(p_v, p_v), dot(p_uu, minus_n), dot(p_uv, minus_n), dot(p_vv, minus_n)]
+    )
     return ref, cross
 
 
@@ -92,7 +94,7 @@ def _same(x, y):
 
 @exercise(
     "fundamental_forms",
-    reread="Steps 2 to 4 · the first fundamental form, the normal and the second fundamental form",
+    reread="The definitions and Steps 1-2 · the tangents p_u, p_v and the inward normal p_u x p_v / |p_u x p_v| = -n",
     forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
 )
 def fundamental_forms(fn):
@@ -132,12 +134,12 @@ def fundamental_forms(fn):
         return ["E, F, G, e, f, g at three generic points (F != 0) of three ellipsoids"]
     if _same(second, ref[3:][swap]):
         raise Mistake(
-            "u and v are swapped in the second fundamental form: e and g are exchanged", "e = p_uu . N, g = p_vv . N"
+            "u and v are swapped in the second fundamental form: e and g are exchanged", "e = -p_uu . n, g = -p_vv . n"
         )
     if _same(second, -ref[3:]):
         raise Mistake(
             "the sign of the normal is flipped: e, f, g are all negated",
-            "the workbook's II uses the inward normal N = p_u x p_v / |p_u x p_v| on this ellipsoid, "
+            "the workbook's II uses the inward normal -n = p_u x p_v / |p_u x p_v| on this ellipsoid, "
             "so that every curvature of a convex surface is positive",
         )
     for sign in (1, -1):
@@ -152,12 +154,12 @@ def fundamental_forms(fn):
     if usable.any() and np.allclose(ratio[usable], ratio[usable][0]) and not np.isclose(abs(ratio[usable][0]), 1):
         raise Mistake(
             f"e, f, g are all off by the same factor {ratio[usable][0]:.4g}: the normal is not a unit vector",
-            "N = p_u x p_v / |p_u x p_v|",
+            "-n = p_u x p_v / |p_u x p_v|, a unit vector",
         )
     wrong = [n for n, x, y in zip(_NAMES[3:], second, ref[3:]) if not _same(x, y)]
     raise Mistake(
-        f"{', '.join(wrong)} of the second fundamental form differ from p_uu . N, p_uv . N, p_vv . N",
-        "take the second derivatives of p and dot them with the unit normal N = p_u x p_v / |p_u x p_v|",
+        f"{', '.join(wrong)} of the second fundamental form differ from -p_uu . n, -p_uv . n, -p_vv . n",
+        "take the second derivatives of p and dot them with the unit normal -n = p_u x p_v / |p_u x p_v|",
         typical=False,
     )
 
@@ -169,7 +171,7 @@ _PHIS = np.array([0.0, 0.4, 1.1, np.pi / 2, 2.5, 4.0])
 
 @exercise(
     "normal_curvature",
-    reread="Step 6 · The normal curvature kappa_n(phi)",
+    reread="Step 4 · The point (a, 0, 0) and its normal sections",
     forbid=(
         "lessons.symbolic.ellipsoid_normal_curvature",
         "lessons.symbolic.ParametricSurface",
@@ -210,7 +212,8 @@ def normal_curvature(fn):
         (
             np.broadcast_to(a, right.shape),
             "kappa_n = a for every phi: II(t, t) is not divided by the first form",
-            "kappa_n = II(t, t) / I(t, t); with (du, dv) = (cos phi, sin phi), I(t, t) = b^2 cos^2 phi + c^2 sin^2 phi",
+            "kappa_n = II(t, t) / I(t, t); the unit tangent at angle phi from p_u has (du, dv) = "
+            "(cos phi / b, sin phi / c), since |p_u| = b and |p_v| = c, and then I(t, t) = 1",
         ),
         (
             np.broadcast_to(a / b**2, right.shape),
@@ -221,6 +224,11 @@ def normal_curvature(fn):
             a / (b**2 * cos2 + c**2 * sin2),
             "phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi) treats p_u, p_v as unit vectors",
             "the unit tangent at angle phi has (du, dv) = (cos phi / b, sin phi / c), since |p_u| = b and |p_v| = c",
+        ),
+        (
+            a * cos2 / b + a * sin2 / c,
+            "kappa_n(0) came out a / b: II is divided by the length |p_u| = b, not by I(p_u, p_u) = b^2",
+            "with (du, dv) = (cos phi / b, sin phi / c), II(t, t) = a cos^2 phi / b^2 + a sin^2 phi / c^2",
         ),
         (
             a * cos2 / b**4 + a * sin2 / c**4,

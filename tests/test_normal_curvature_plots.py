@@ -1,0 +1,40 @@
+"""The diagram of notebook 02: the normal section is drawn from the ellipsoid's own geometry."""
+
+import matplotlib
+import numpy as np
+import pytest
+
+from geomlib.teaching.normal_curvature_plots import normal_section, normal_section_figure
+
+matplotlib.use("Agg")
+
+
+@pytest.mark.parametrize("abc,phi,uv", [((1.0, 0.7, 0.5), 0.7, (0.0, np.pi / 2)), ((2.0, 1.3, 0.6), 2.2, (0.7, 1.0))])
+def test_the_section_lies_on_the_surface_and_in_the_normal_plane(abc, phi, uv):
+    s = normal_section(*abc, phi, *uv)
+    C, P, t, n = s["curve"], s["P"], s["t"], s["n"]
+    assert np.abs((C**2 / np.square(abc)).sum(axis=1) - 1).max() < 1e-12
+    assert np.abs((C - P) @ np.cross(t, n)).max() < 1e-12
+    assert np.allclose(C[0], P) and np.allclose(C[-1], P)
+    assert abs(t @ n) < 1e-12 and abs(np.linalg.norm(t) - 1) < 1e-12
+    # t is at angle phi from p_u, turning towards p_v
+    t_u = s["p_u"] / np.linalg.norm(s["p_u"])
+    assert np.isclose(t @ t_u, np.cos(phi)) and s["w"] @ s["p_v"] > 0
+
+
+def test_the_curvature_of_the_drawn_curve_at_the_point_is_kappa_n():
+    a, b, c, phi = 1.0, 0.7, 0.5, np.radians(40)
+    s = normal_section(a, b, c, phi, samples=20001)
+    # the curve near P as a height h(q) over the tangent t, towards -n: h ~ kappa_n q^2 / 2
+    near = s["curve"][1:40] - s["P"]
+    q, h = near @ s["t"], -(near @ s["n"])
+    kappa = np.polyfit(q, h, 4)[-3] * 2
+    assert abs(kappa - s["kappa_n"]) < 1e-6 * s["kappa_n"]
+    assert np.isclose(s["kappa_n"], a * np.cos(phi) ** 2 / b**2 + a * np.sin(phi) ** 2 / c**2)
+
+
+def test_the_figure_says_what_it_shows():
+    fig, alt = normal_section_figure(1.0, 0.7, 0.5, np.radians(40))
+    texts = {t.get_text() for t in fig.axes[0].texts}
+    assert {"$p_u$", "$p_v$", r"$t(\varphi)$", "$n$", r"$\varphi$"} <= texts
+    assert "phi = 40 degrees" in alt and "kappa_n = 2.850" in alt and "1/kappa_n = 0.351" in alt
