@@ -356,6 +356,7 @@ def _near(value, target):
         "teaching.sweep.smoothing_sweep",
         "teaching.sweep.denoising_comparison",
     ),
+    allow=("lessons.smoothing.implicit_smoothing",),
 )
 def denoising_experiment(fn):
     """Check ``fn(V_clean, F, sigma, tau, iterations, seed) -> E`` (module docstring)."""

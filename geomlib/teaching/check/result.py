@@ -177,8 +177,8 @@ def _entry_points(dotted):
 class _Rules:
     """The ground rules of one exercise: the geomlib routines its answer may not call."""
 
-    def __init__(self, forbid, own):
-        self.forbid, self.own = tuple(forbid), tuple(own)
+    def __init__(self, forbid, own, allow=()):
+        self.forbid, self.own, self.allow = tuple(forbid), tuple(own), tuple(allow)
         self._watch = None
 
     def watch(self):
@@ -192,7 +192,10 @@ class _Rules:
         if not self.forbid:
             return "Any geomlib routine may be used."
         names = ", ".join(f"`{_public(d)}`" for d in self.forbid)
-        return f"Ground rules: write it with numpy and scipy; do not call geomlib's {names}."
+        tools = "numpy and scipy"
+        if self.allow:
+            tools += " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
+        return f"Ground rules: write it with {tools}; do not call geomlib's {names}."
 
     def refusal(self, dotted):
         why = (
@@ -325,14 +328,18 @@ def _enforce(result):
     return result
 
 
-def exercise(name, reread, forbid=(), own=None):
+def exercise(name, reread, forbid=(), own=None, allow=()):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
 
     ``forbid``: dotted names inside geomlib of the routines the answer may not call;
     ``own``: those of them that are the exercise's own routine, revealed by ``reveal``
-    (default: the first).
+    (default: the first); ``allow``: geomlib routines the exercise hands the student
+    (named in the ground rules' sentence; any routine not forbidden may be called).
     """
-    rules = _Rules(forbid, forbid[:1] if own is None else own)
+    overlap = set(forbid) & set(allow)
+    if overlap:
+        raise ValueError(f"exercise {name}: {sorted(overlap)} both forbidden and allowed")
+    rules = _Rules(forbid, forbid[:1] if own is None else own, allow)
 
     def wrap(body):
         def evaluate(fn):
@@ -372,7 +379,7 @@ def exercise(name, reread, forbid=(), own=None):
             return _enforce(CheckResult(f"{name}, partial credit", result.partial, message, written=result.written))
 
         check.exercise, check.reread = name, reread
-        check.forbid, check.own, check.rules = rules.forbid, rules.own, rules.sentence()
+        check.forbid, check.own, check.allow, check.rules = rules.forbid, rules.own, rules.allow, rules.sentence()
         check.evaluate, check.partial_credit = evaluate, partial_credit
         return check
 
