@@ -11,6 +11,7 @@ import re
 
 import ipywidgets
 import matplotlib
+import matplotlib.pyplot
 import numpy as np
 import pytest
 import trimesh
@@ -59,7 +60,7 @@ def test_colorize_maps_ends_middle_and_clips():
     np.testing.assert_allclose(colors[4], colors[2])  # clipped above
 
 
-def test_nan_is_grey_and_counted(sphere):
+def test_nan_is_drawn_violet_and_counted(sphere):
     V, F = sphere
     values = V[:, 0].copy()
     values[[3, 7, 11]] = np.nan
@@ -69,8 +70,72 @@ def test_nan_is_grey_and_counted(sphere):
     assert not np.isnan(view.colors).any()
     lo, hi = view.range
     assert lo == pytest.approx(np.nanmin(values)) and hi == pytest.approx(np.nanmax(values))
-    assert "NaN (3)" in view._colorbar.value
-    assert "3 NaN drawn grey" in view.summary()
+    assert f"NaN: {NAN_NAME} (3)" in view._colorbar.value
+    assert f"3 NaN drawn {NAN_NAME}" in view.summary()
+
+
+def _lab(rgb):
+    """CIELAB of sRGB colours in [0, 1] (D65)."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    lin = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    XYZ = lin @ np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722], [0.0193, 0.1192, 0.9505]]).T
+    XYZ = XYZ / np.array([0.9505, 1.0, 1.089])
+    f = np.where(XYZ > 0.008856, np.cbrt(XYZ), 7.787 * XYZ + 16 / 116)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], -1)
+
+
+# colour-vision deficiencies at full severity on linear RGB (Machado, Oliveira and Fernandes 2009)
+CVD = {
+    "protan": [[0.152286, 1.052583, -0.204868], [0.114503, 0.786281, 0.099216], [-0.003882, -0.048116, 1.051998]],
+    "deutan": [[0.367322, 0.860646, -0.227968], [0.280085, 0.672501, 0.047413], [-0.011820, 0.042940, 0.968881]],
+    "tritan": [[1.255528, -0.076749, -0.178779], [-0.078411, 0.930809, 0.147602], [0.004733, 0.691367, 0.303900]],
+}
+
+
+def _seen(rgb, matrix, shade):
+    """sRGB colours as a reader with the deficiency ``matrix`` sees them, shaded by ``shade``."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    lin = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    lin = np.clip(lin @ np.asarray(matrix).T, 0, 1) * shade
+    return np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
+
+
+def test_nan_colour_stands_apart_from_the_maps_for_colour_blind_readers():
+    # at every shade the head light gives, for normal vision and the three deficiencies, NaN's
+    # colour is at least 20 CIELAB units from every colour of both maps (the old grey: 4.9)
+    worst = {}
+    for name in ("viridis", "RdBu_r"):
+        lut = matplotlib.colormaps[name](np.linspace(0, 1, 256))[:, :3]
+        for kind, matrix in {"normal": np.eye(3), **CVD}.items():
+            for shade in (0.45, 0.7, 1.0):
+                d = np.linalg.norm(_lab(_seen(lut, matrix, shade)) - _lab(_seen(NAN_COLOR, matrix, shade)), axis=1)
+                worst[(name, kind, shade)] = float(d.min())
+    assert min(worst.values()) > 20, min(worst.items(), key=lambda kv: kv[1])
+    grey = (0.62, 0.62, 0.62)
+    lut = matplotlib.colormaps["viridis"](np.linspace(0, 1, 256))[:, :3]
+    d = np.linalg.norm(_lab(_seen(lut, CVD["deutan"], 1.0)) - _lab(_seen(grey, CVD["deutan"], 1.0)), axis=1)
+    assert d.min() < 8  # the test can fail: the grey it replaces sits in viridis for deutan readers
+
+
+def test_plot_cycle_is_colour_blind_safe_with_a_line_style_per_colour():
+    from geomlib.teaching.colours import PLOT_COLOURS, PLOT_LINESTYLES, plot_style
+
+    cycle = list(plot_style()["axes.prop_cycle"])
+    assert len(cycle) == len(PLOT_COLOURS) == len({str(c["linestyle"]) for c in cycle})  # no style repeats
+    white = _lab([1.0, 1.0, 1.0])
+    for colour in PLOT_COLOURS:
+        rgb = np.asarray(matplotlib.colors.to_rgb(colour))
+        lin = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+        luminance = float(lin @ [0.2126, 0.7152, 0.0722])
+        assert 1.05 / (luminance + 0.05) >= 3.0, colour  # a line against the white page
+        assert np.linalg.norm(_lab(rgb) - white) > 30
+    with matplotlib.rc_context(plot_style()):
+        fig, ax = matplotlib.pyplot.subplots()
+        lines = [ax.plot([0, 1], [k, k])[0] for k in range(3)]
+        assert len({line.get_linestyle() for line in lines}) == 3
+        assert matplotlib.colors.to_hex(lines[1].get_color()) == PLOT_COLOURS[1].lower()
+        matplotlib.pyplot.close(fig)
+    assert PLOT_LINESTYLES[0] == "-"
 
 
 def test_symmetric_range_is_centred_on_zero(sphere):
@@ -475,7 +540,7 @@ def test_a_field_zero_up_to_rounding_draws_white(sphere):
     assert not MeshView(V, F, values=rounding, symmetric=True, zero_tol=0.0).is_zero
 
 
-def test_zero_field_keeps_nan_grey(sphere):
+def test_zero_field_keeps_nan_violet(sphere):
     V, F = sphere
     values = np.zeros(len(V))
     values[:5] = np.nan

@@ -2,7 +2,7 @@
 
 The glyphs are small closed triangle meshes (an arrow: a prism shaft and a cone
 tip; a marker: an octahedron) appended to the surface, each with one value for
-the colour map (NaN draws it grey). One merged mesh is one :class:`MeshView`:
+the colour map (NaN draws it bright violet). One merged mesh is one :class:`MeshView`:
 the still picture shows the glyphs too, and ``view.update`` moves them with the
 surface as long as their number stays the same.
 
@@ -63,7 +63,7 @@ class Glyphs:
     Parameters
     ----------
     V, F : the surface.
-    values : (n,) per-vertex values of the surface, or None (NaN: grey).
+    values : (n,) per-vertex values of the surface, or None (NaN: bright violet).
     size : float
         The scene's size (e.g. its largest semi-axis or half diagonal): arrows
         are ``size / 2`` long and ``0.015 size`` thick, markers ``2.5`` times that.
@@ -80,12 +80,12 @@ class Glyphs:
         self.parts.append((V, F, np.repeat(values, per_glyph)))
 
     def add_arrows(self, origins, directions, values=np.nan, length=None, radius=None):
-        """Arrows from each origin along its direction (normalised), one value each (NaN: grey)."""
+        """Arrows from each origin along its direction (normalised), one value each (NaN: bright violet)."""
         V, F = arrow_meshes(origins, directions, length or self.length, radius or self.radius)
         self._add(V, F, values, 3 * 8 + 2)
 
     def add_points(self, points, values=np.nan, radius=None):
-        """A marker (octahedron) at each point, one value each (NaN: grey)."""
+        """A marker (octahedron) at each point, one value each (NaN: bright violet)."""
         V, F = marker_meshes(points, radius or 2.5 * self.radius)
         self._add(V, F, values, 6)
 

@@ -8,8 +8,9 @@ Convention: a view shows ``V`` (n, 3) float64 and ``F`` (m, 3) int64 as a
 smooth-shaded surface, optionally coloured by a per-vertex scalar ``values``
 (n,) through a named matplotlib colour map, with a colour bar giving the value
 range. Signed quantities (``symmetric=True``) get a diverging map whose centre
-is exactly zero; NaN values are drawn in a neutral grey and counted under the
-colour bar.
+is exactly zero; NaN values are drawn bright violet (``colours.NAN_COLOR``, far
+from every colour of the maps for colour-blind readers too) and counted under the
+colour bar, which names the colour.
 
     from geomlib.teaching.viewer import MeshView, side_by_side
     view = MeshView(V, F, values=H, symmetric=True, label="H (1/length)")
@@ -130,6 +131,7 @@ from .colours import (
     colorize,
     colour_table,
     format_value,
+    use_plot_style,
     value_range,
     zero_html,
 )
@@ -261,7 +263,7 @@ class MeshView:
 
     Convention: V (n, 3) float64, F (m, 3) int64 counter-clockwise from outside;
     ``values`` (n,) in their own units, mapped linearly from ``[vmin, vmax]``
-    onto the colour map (clipped outside), NaN drawn grey.
+    onto the colour map (clipped outside), NaN drawn in ``NAN_COLOR`` (bright violet).
 
     Parameters
     ----------
@@ -658,7 +660,7 @@ class MeshView:
             text += f"; {name} coloured by {self.cmap} over [{format_value(lo)}, {format_value(hi)}]"
             n_nan = int(np.isnan(self._values).sum())
             if n_nan:
-                text += f", {n_nan} NaN drawn grey"
+                text += f", {n_nan} NaN drawn {NAN_NAME}"
         return text
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
@@ -764,7 +766,7 @@ def _widget_stills_only(widget):
 def _give_boxes_stills():
     """In IPython, display every ipywidgets box with the still of its views as image/png
     (with ``stills_only``, every widget without its widget view: a box as the still of
-    its views, any other as its text)."""
+    its views, any other as its text), and draw plots in :func:`.colours.plot_style`."""
     from IPython import get_ipython
 
     shell = get_ipython()
@@ -774,6 +776,8 @@ def _give_boxes_stills():
         shell.display_formatter.formatters["image/png"].for_type(ipywidgets.Box, _box_png)
         if stills_only():
             shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_stills_only)
+        # a notebook's own plots: colour-blind-safe colours, each with its own line style
+        use_plot_style()
 
 
 _give_boxes_stills()
