@@ -786,7 +786,7 @@ def ellipsoid_forms(a, b, c, u, v):
     sympy symbols; nothing is simplified. ``ellipsoid(a, b, c)`` derives the
     same forms, kept short for the general ellipsoid.
     """
-    s, t = _U, _V  # differentiate in symbols, then put (u, v) in: they may be numbers
+    s, t = sp.symbols("u v", real=True)  # differentiate in symbols, then put (u, v) in: they may be numbers
     p = sp.Matrix([a * sp.cos(s) * sp.sin(t), b * sp.sin(s) * sp.sin(t), c * sp.cos(t)])
     p_u, p_v = p.diff(s), p.diff(t)
     m = p_u.cross(p_v)
