@@ -154,7 +154,7 @@ def course(tmp_path_factory):
     hand_in(course, "stubs")
     hand_in(course, "solved", lambda exercise, source: source)
     hand_in(course, "one_mistake", flip_the_sign_of_C)
-    nbgrader(course, "autograde", ASSIGNMENT)
+    (course / "autograde.log").write_text(nbgrader(course, "autograde", ASSIGNMENT).stderr)
     nbgrader(course, "export", "--to", str(course / "grades.csv"))
     nbgrader(course, "generate_feedback", ASSIGNMENT)
     return course
@@ -210,6 +210,28 @@ def test_grading_puts_the_model_answers_back(course):
         hidden = [i for i, c in enumerate(solution.cells) if build_assignment.HIDDEN_BEGIN in c.source]
         for i in hidden:
             assert graded.cells[i].source == solution.cells[i].source
+
+
+@pytest.mark.slow
+def test_autograde_warns_only_of_the_model_answers_it_puts_back(course):
+    """The grading guide tells a lecturer to expect these warnings, and no others."""
+    warnings = [line for line in (course / "autograde.log").read_text().splitlines() if "| WARNING]" in line]
+    expected = [
+        (student, answer)
+        for student in ("stubs", "solved", "one_mistake")
+        for name in GRADED.values()
+        for answer in model_answers(ROOT / "notebooks" / f"{name}.ipynb")
+    ]
+    cells = [re.search(r"Attribute 'checksum' for cell (\w+_model_answer) has changed!", w) for w in warnings]
+    assert all(cells), warnings
+    assert sorted(c.group(1) for c in cells) == sorted(answer for _, answer in expected)
+    assert '_model_answer has changed!": expected' in " ".join(GRADING.read_text().split())
+
+
+def model_answers(path):
+    """The grade ids of a notebook's model-answer cells."""
+    ids = (c.metadata.get("nbgrader", {}).get("grade_id", "") for c in nbformat.read(path, as_version=4).cells)
+    return [grade_id for grade_id in ids if grade_id.endswith("_model_answer")]
 
 
 def view_outputs(nb):
