@@ -35,8 +35,14 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 EXERCISE_NOTEBOOKS = [p for p in NOTEBOOKS if p.name[:2] != "00" and p.name[2] == "_"]
 BIN = Path(sys.executable).parent
 ASSIGNMENT = "curvature"
-# the notebooks the three students hand in: the first task and the smoothing tasks
-GRADED = {"01": "01_uniform_laplace_curvature", "05": "05_explicit_smoothing"}
+# the notebooks the three students hand in: the first task and those whose exercises carry the
+# coursework (the eigenproblem, the smoothing loop, the denoising experiment)
+GRADED = {
+    "01": "01_uniform_laplace_curvature",
+    "04": "04_spectral_reconstruction",
+    "05": "05_explicit_smoothing",
+    "07": "07_denoising_evaluation",
+}
 WRONG_EXERCISE = "uniform_laplacian"
 DIAGNOSIS = "the sign of C is flipped"
 GRADING = ROOT / "docs" / "grading.md"
@@ -44,7 +50,8 @@ GRADING = ROOT / "docs" / "grading.md"
 
 def guide_points():
     """{(notebook, exercise): (check, partial credit, by hand, total)} from the grading guide's table."""
-    rows = re.findall(r"^\| (\d\d) \| `(\w+)` \| (\d*) \| (\d*) \| (\d*) \| (\d+) \|$", GRADING.read_text(), flags=re.M)
+    cell = r"\|\s*(\d*)\s*"
+    rows = re.findall(rf"^\| (\d\d) \| `(\w+)` {cell * 3}\| (\d+) \|$", GRADING.read_text(), flags=re.M)
     return {(nb, ex): tuple(int(x or 0) for x in values) for nb, ex, *values in rows}
 
 
@@ -179,12 +186,13 @@ def test_autograde_scores_stubs_zero_a_typical_mistake_fewer_solutions_full_and_
             assert [nb.max_score for nb in got] == [a + h for a, h in zip(auto, hand)]
             # an answer box left blank scores 0 at once; a written answer waits for a grader
             assert all(nb.needs_manual_grade == (student != "stubs") for nb in got), student
-        # a grader enters the hand-graded points of the solved student: the score includes them
+        # a grader enters the hand-graded points of the solved student, as the formgrader's grade
+        # handler does (the score and the flag): the score includes them
         for name in GRADED.values():
             submission = gb.find_submission_notebook(name, ASSIGNMENT, "solved")
             for grade in submission.grades:
                 if grade.cell.max_score and grade.needs_manual_grade:
-                    grade.manual_score = grade.cell.max_score
+                    grade.manual_score, grade.needs_manual_grade = grade.cell.max_score, False
             gb.db.commit()
         got = [gb.find_submission_notebook(name, ASSIGNMENT, "solved") for name in GRADED.values()]
         assert [nb.score for nb in got] == [a + h for a, h in zip(auto, hand)]

@@ -118,3 +118,27 @@ def test_a_plot_in_an_output_widget_is_not_replayed(tmp_path):
     record([ipywidgets.VBox([a, out]).model_id], str(tmp_path / "states.json"))
     states = json.loads((tmp_path / "states.json").read_text())
     assert states["sliders"] == [] and states["left_out"][0]["description"] == "a"
+
+
+def test_the_text_alternative_of_a_view_moves_with_its_slider(tmp_path):
+    # the website replays the caption under a view (its alt_text) with the view: a description
+    # the callback sets for a value is the one the page shows, and announces, for that value
+    base, H0, _ = _curvatures(0.0)
+    view = MeshView(base.V, base.F, H0, symmetric=True, label="H (length)", description="smooth saddle")
+    jitter = ipywidgets.FloatSlider(value=0.0, min=0.0, max=JITTER_MAX, step=JITTER_MAX / 8, description="jitter")
+
+    def on_jitter(change):
+        s, H, _ = _curvatures(change["new"])
+        view.update(V=s.V, values=H, description=f"vertices moved by up to {change['new']:.2f} of an edge")
+
+    jitter.observe(on_jitter, "value")
+    box = ipywidgets.VBox([jitter, view.widget])
+    record([box.model_id], str(tmp_path / "states.json"))
+    (slider,) = json.loads((tmp_path / "states.json").read_text())["sliders"]
+    (caption,) = [t for t in slider["traits"] if t["model_id"] == view._caption.model_id]
+    j = slider["values"].index(0.25)
+    assert "Vertices moved by up to 0.25 of an edge." in caption["states"][j]
+    assert "Smooth saddle." in caption["states"][slider["default"]]
+    s, H, _ = _curvatures(0.25)
+    view.update(V=s.V, values=H, description="vertices moved by up to 0.25 of an edge")
+    assert caption["states"][j] == view._caption.value  # what the kernel would show

@@ -1,5 +1,6 @@
 """Tests for geomlib.lessons.spectral: C e = -lam M e, E^T M E = I, reconstruction, cache."""
 
+import re
 import sys
 import warnings
 
@@ -556,3 +557,51 @@ def test_lanczos_resolves_repeated_eigenvalues():
     lam, Y = eigen.smallest_eigenpairs(sp.diags(d).tocsr(), 12, 1e-4, "sparse")
     np.testing.assert_allclose(lam, d[:12], atol=1e-12)
     assert np.abs(Y.T @ Y - np.eye(12)).max() < 1e-12
+
+
+# --------------------------------------------------------------------------
+# eigenpairs(M, C, k): the solve for a given pair (notebook 04's exercise and its fallback)
+
+
+def test_eigenpairs_of_the_pair_is_eigenbasis(egg):
+    from geomlib.lessons.spectral import eigenpairs
+
+    V, F = egg
+    M, C = laplacian(V, F)
+    lam, E = eigenpairs(M, C, 12)
+    lam_b, E_b = eigenbasis(V, F, 12)
+    np.testing.assert_allclose(lam, lam_b, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(E, E_b, atol=1e-8)  # same signs: the entry of largest magnitude is positive
+    # dense arrays are taken as well
+    np.testing.assert_allclose(eigenpairs(M.toarray(), C.toarray(), 12)[0], lam, rtol=1e-10, atol=1e-12)
+
+
+def test_eigenpairs_finds_the_components_from_C():
+    from geomlib.lessons.spectral import eigenpairs
+
+    P, F = icosphere(1)
+    V = np.vstack([0.5 * P, P + [3.0, 0.0, 0.0]])  # the larger piece second
+    FF = np.vstack([F, F + len(P)])
+    M, C = laplacian(V, FF)
+    with pytest.warns(MeshWarning, match="2 connected components"):
+        lam, E = eigenpairs(M, C, 5)
+    m = M.diagonal()
+    assert lam[:2].tolist() == [0.0, 0.0] and lam[2] > 1.0
+    np.testing.assert_allclose(E[len(P) :, 0], 1 / np.sqrt(m[len(P) :].sum()))  # largest area first
+    np.testing.assert_allclose(E[: len(P), 0], 0.0)
+
+
+@pytest.mark.parametrize(
+    "M, C, k, phrase",
+    [
+        (np.eye(3), np.zeros((4, 4)), 1, "square and of one size"),
+        (np.ones((3, 3)), np.zeros((3, 3)), 1, "M must be diagonal"),
+        (np.diag([1.0, 0.0, 1.0]), np.zeros((3, 3)), 1, "M_ii is zero at 1 of 3 vertices"),
+        (np.eye(3), np.zeros((3, 3)), 4, "at most n = 3"),
+    ],
+)
+def test_eigenpairs_names_bad_input(M, C, k, phrase):
+    from geomlib.lessons.spectral import eigenpairs
+
+    with pytest.raises(MeshError, match=re.escape(phrase)):
+        eigenpairs(M, C, k)

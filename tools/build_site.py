@@ -176,10 +176,10 @@ body.jp-Notebook {
   --jp-mirror-editor-quote-color: #007a00; --jp-mirror-editor-builtin-color: #007a00;
   --jp-mirror-editor-keyword-color: #007a00;
 }
-.jupyter-widgets.widget-slider .noUi-target, .jupyter-widgets .widget-slider .noUi-target,
-.widget-slider .noUi-target { background: #8a8a8a; border-color: #6b6b6b; }
-.widget-slider .noUi-handle { border-color: #6b6b6b !important; }
-.widget-inline-hbox .widget-label { width: auto; min-width: var(--jp-widgets-inline-label-width);
+body.jp-Notebook .widget-slider .noUi-target { background: #8a8a8a; border-color: #6b6b6b; }
+body.jp-Notebook .widget-slider .noUi-handle { border-color: #6b6b6b; }
+/* the widgets' style sheet comes after this one (the page adds it when it loads): hence body.jp-Notebook */
+body.jp-Notebook .widget-inline-hbox .widget-label { width: auto; min-width: var(--jp-widgets-inline-label-width);
   overflow: visible; text-overflow: clip; }
 /* links in running text are told apart by more than their colour (WCAG 1.4.1) */
 body.jp-Notebook .jp-RenderedHTMLCommon a, body.jp-Notebook .jp-RenderedHTMLCommon a:link,

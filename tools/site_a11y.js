@@ -247,6 +247,24 @@
     requestAnimationFrame(function () { scheduled = false; fixAll(document); });
   }
 
+  // nbconvert makes every cell's input and output a Tab stop, so that a reader can scroll one
+  // that is wider than the page; only those that are wider stay Tab stops (about 2,200 stops
+  // a site otherwise, before the first slider)
+  function trimTabStops() {
+    document.querySelectorAll(".jp-Cell-inputWrapper[tabindex], .jp-OutputArea-output[tabindex]").forEach(
+      function (el) {
+        var scrolls = Array.prototype.some.call(el.querySelectorAll("*"), function (child) {
+          return child.scrollWidth > child.clientWidth + 1 && /auto|scroll/.test(getComputedStyle(child).overflowX);
+        }) || el.scrollWidth > el.clientWidth + 1;
+        if (!scrolls) el.removeAttribute("tabindex");
+      });
+  }
+
+  window.addEventListener("load", function () {
+    if (window.MathJax && MathJax.Hub) MathJax.Hub.Queue(trimTabStops);
+    else trimTabStops();
+  });
+
   document.addEventListener("DOMContentLoaded", function () {
     live = document.getElementById("site-live");
     fixAll(document);

@@ -23,6 +23,7 @@ precomputed slider moved from the keyboard is announced in the live region with 
 value it shows.
 """
 
+import json
 import sys
 from pathlib import Path
 
@@ -69,6 +70,8 @@ JS_PAGE = r"""
     formulaStops: Array.from(document.querySelectorAll('.MathJax_CHTML, .MathJax, .mjx-chtml'))
       .filter(m => m.tabIndex >= 0).length,
     live: document.querySelectorAll('[aria-live=polite]').length,
+    tabStops: focusable.length,
+    beforeSlider: (() => { const i = focusable.findIndex(el => el.getAttribute('role') === 'slider'); return i; })(),
     sliders: sliders, views: views, images: images, tracks: tracks,
   };
 }
@@ -164,7 +167,7 @@ def test_every_page_meets_wcag_aa_offline(site, browser):
         finally:
             context.close()
         by_impact, _ = axe_audit.counts(found)
-        totals[name] = dict(by_impact)
+        totals[name] = dict(by_impact) | {"tab stops": info["tabStops"], "to the first slider": info["beforeSlider"]}
         for v in found:
             if v["impact"] in ("serious", "critical"):
                 where = "; ".join(n["target"] for n in v["nodes"][:3])
@@ -172,7 +175,7 @@ def test_every_page_meets_wcag_aa_offline(site, browser):
         widgets = bool(info["sliders"] or info["views"])
         problems += _problems(name, info, cut, widgets)
         problems += [f"{name}: uncaught {e}" for e in errors]
-    print("axe violations per page (nodes by impact):", totals)
+    print("axe violations per page (nodes by impact), Tab stops:", json.dumps(totals, indent=1))
     assert not (violations or problems), "\n".join(
         ["axe-core, serious or critical:", *violations, "the page's own checks:", *problems]
     )

@@ -192,10 +192,10 @@ class _Rules:
         if not self.forbid:
             return "Any geomlib routine may be used."
         names = ", ".join(f"`{_public(d)}`" for d in self.forbid)
-        tools = "numpy and scipy"
+        tools = "numpy, scipy or sympy"
         if self.allow:
             tools += " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
-        return f"Ground rules: write it with {tools}; do not call geomlib's {names}."
+        return f"Ground rules: write it yourself with {tools}; do not call geomlib's {names}."
 
     def refusal(self, dotted):
         why = (
