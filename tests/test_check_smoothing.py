@@ -360,3 +360,36 @@ def test_the_loop_may_not_hand_the_work_to_geomlibs_smoothers():
         (lambda V, F, tau, n: LaplaceOperator(V, F).M_step @ V, "LaplaceOperator"),
     ):
         assert_diagnosed(check.smoothing_loop(fn), f"`{named}`", "earns no points")
+
+
+def zeroed_boundary_areas(V, F, tau, iterations):
+    M, C = laplacian(V, F)
+    moving, P = ~held(F, len(V)), V.copy()
+    m = M.diagonal().copy()
+    m[~moving] = 0.0  # "no area, no motion": 0 * (C P / 0) is NaN on the boundary rows
+    for _ in range(iterations):
+        P = P + tau * moving[:, None] * (C @ P) / m[:, None]
+    return P
+
+
+NAN_MISTAKES = {
+    # each exercise's NaN gets the hint of its own likely cause, not another exercise's
+    "explicit step, dense 1 / M": (
+        check.explicit_step,
+        lambda P, M, C, tau: P + tau * (1 / M.toarray()) @ (C @ P),
+        "not by a dense 1 / M",
+    ),
+    "loop, boundary areas zeroed": (check.smoothing_loop, zeroed_boundary_areas, "areas zeroed on the boundary rows"),
+    "implicit step, dense 1 / M": (
+        check.implicit_step,
+        lambda P, M, C, tau: solve(np.eye(len(P)) - tau * (1 / M.toarray()) @ C.toarray(), P),
+        "the system's matrix holds infinities",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", NAN_MISTAKES)
+@pytest.mark.filterwarnings("ignore::RuntimeWarning", "ignore::scipy.sparse.linalg.MatrixRankWarning")
+def test_nan_positions_are_told_their_own_cause(name):
+    run_check, fn, phrase = NAN_MISTAKES[name]
+    assert_diagnosed(run_check(fn), "NaN or infinite positions", phrase)

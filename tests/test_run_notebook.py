@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 import run_notebook as rn  # noqa: E402
 from run_notebook import Choice, FilePath, Number, NumberOrDict, Sequence, UsageError  # noqa: E402
 
-NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]*_*.ipynb"))  # cores and appendices
 
 
 def _parameters_cell(path):
@@ -208,6 +208,8 @@ def test_a_notebook_by_number_name_or_file_name():
     assert rn.find_notebook("05_explicit_smoothing.ipynb") == rn.find_notebook("notebooks/" + path.name) == path
     with pytest.raises(UsageError, match=r"^There is no notebook '5'; the notebooks are 00_getting_started, "):
         rn.find_notebook("5")
+    (appendix,) = (ROOT / "notebooks").glob("05a_*.ipynb")
+    assert rn.find_notebook("05a") == rn.find_notebook(appendix.name) == appendix
 
 
 @pytest.mark.parametrize(

@@ -137,8 +137,8 @@ def test_the_text_alternative_of_a_view_moves_with_its_slider(tmp_path):
     (slider,) = json.loads((tmp_path / "states.json").read_text())["sliders"]
     (caption,) = [t for t in slider["traits"] if t["model_id"] == view._caption.model_id]
     j = slider["values"].index(0.25)
-    assert "vertices moved by up to 0.25 of an edge" in caption["states"][j]
-    assert "smooth saddle" in caption["states"][slider["default"]]
+    assert "Vertices moved by up to 0.25 of an edge." in caption["states"][j]
+    assert "Smooth saddle." in caption["states"][slider["default"]]
     s, H, _ = _curvatures(0.25)
     view.update(V=s.V, values=H, description="vertices moved by up to 0.25 of an edge")
     assert caption["states"][j] == view._caption.value  # what the kernel would show

@@ -312,6 +312,8 @@ def test_alt_text_says_mesh_quantity_range_nans_and_what_to_look_for(sphere, mes
     assert all(name != "HTML" for name, _ in messages)
     view.update(description="Only the words change.")
     assert view.alt_text().endswith("Only the words change.") and "Only the words" in view._caption.value
+    view.update(description="  the rim   flattens first ")  # a sentence of its own
+    assert view.alt_text().endswith("(NaN), drawn bright violet. The rim flattens first.")
     # plain and zero views say so; no description, no trailing words
     assert MeshView(V, F).alt_text() == "3D view: a mesh of 642 vertices and 1280 faces, plain shading (no colour map)."
     zero = MeshView(V, F, values=np.zeros(len(V)), label="K")
@@ -333,7 +335,7 @@ def test_the_still_of_a_box_of_views_carries_their_alt_text(sphere):
     data, metadata = formatter.format(box)
     assert "image/png" in data and metadata["image/png"]["alt"] == box_alt(box)
     data, metadata = formatter.format(a)
-    assert metadata["image/png"]["alt"] == a.alt_text() and a.alt_text().endswith("look at a")
+    assert metadata["image/png"]["alt"] == a.alt_text() and a.alt_text().endswith("Look at a.")
 
 
 def test_still_puts_the_mesh_in_the_middle():

@@ -276,8 +276,9 @@ def notebook_parameters(path):
 
 
 def find_notebook(name):
-    """The notebook ``name`` means: ``05``, ``05_explicit_smoothing`` or ``05_explicit_smoothing.ipynb``."""
-    notebooks = sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+    """The notebook ``name`` means: ``05``, ``05_explicit_smoothing`` or ``05_explicit_smoothing.ipynb``
+    (an appendix as ``05a`` or its full name)."""
+    notebooks = sorted([*NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"), *NOTEBOOKS.glob("[0-9][0-9]a_*.ipynb")])
     stem = Path(name).name.removesuffix(".ipynb")
     found = [p for p in notebooks if p.stem == stem or p.stem.split("_", 1)[0] == stem]
     if len(found) != 1:

@@ -563,8 +563,9 @@ class MeshView:
         n_nan = 0 if self._values is None else int(np.isnan(self._values).sum())
         if n_nan:
             text += f" {n_nan} {'vertex has' if n_nan == 1 else 'vertices have'} no value (NaN), drawn {NAN_NAME}."
-        if self.description:
-            text += f" {self.description}"
+        words = " ".join((self.description or "").split())
+        if words:  # a sentence of its own, however the notebook wrote it
+            text += f" {words[0].upper()}{words[1:]}" + ("" if words.endswith((".", "!", "?")) else ".")
         return text
 
     def _caption_text(self):

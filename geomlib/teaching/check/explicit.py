@@ -34,8 +34,14 @@ def step_cases():
     )
 
 
-def positions(out, n, what="the function"):
-    """Check that ``out`` is an (n, 3) array of positions; return it as float."""
+#: What NaN or infinite positions from a step mean: a division by zero (a dense ``1 / M`` divides by its
+#: zeros off the diagonal); the check's meshes have positive areas and its steps are stable.
+_STEP_NAN_HINT = "divide row i of C P by M_ii (M.diagonal(), positive on these meshes), not by a dense 1 / M"
+
+
+def positions(out, n, what="the function", nan_hint=_STEP_NAN_HINT):
+    """Check that ``out`` is an (n, 3) array of positions; return it as float. ``nan_hint`` is the
+    hint for NaN or infinite positions, which each exercise can cause in its own way."""
     P = np.asarray(out.toarray() if hasattr(out, "toarray") else out)
     if P.shape != (n, 3):
         raise Mistake(
@@ -46,7 +52,7 @@ def positions(out, n, what="the function"):
     if not np.isfinite(P.astype(float)).all():
         raise Mistake(
             f"{what} returned NaN or infinite positions",
-            "divide by the vertex areas M_ii, which are positive on these meshes",
+            nan_hint,
             typical=False,
         )
     return P.astype(float)
@@ -272,13 +278,21 @@ def smoothing_loop(fn):
         if label.startswith("a closed"):
             M, C = laplacian(V, F)
             tau = 0.5 * 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[-1]
-        out = positions(call(fn, V.copy(), F.copy(), tau, n), len(V))
+        out = positions(call(fn, V.copy(), F.copy(), tau, n), len(V), nan_hint=_LOOP_NAN_HINT)
         right = _smoothed(V, F, tau, n, fixed=fixed)
         if close(out, right, rtol=0, atol=1e-9 * scale):
             checked.append(label)
             continue
         _loop_mistake(out, V, F, tau, n, fixed, label)
     return checked
+
+
+# the check steps at half the limit, so a right loop stays finite: NaN comes from a division by zero
+_LOOP_NAN_HINT = (
+    "the check steps at half the stability limit, where a right loop stays finite: look for a division by zero "
+    "(divide by M.diagonal(), positive here, not by a dense 1 / M or by areas zeroed on the boundary rows) "
+    "or positions that start unset (np.empty) instead of a copy of V"
+)
 
 
 def _loop_mistake(out, V, F, tau, n, fixed, label):

@@ -23,6 +23,13 @@ _REREAD = "section 1 · Backward Euler, derived"
 AGREE = 1e-3
 
 
+# NaN from a solve comes from its matrix: infinities in it (a dense 1 / M) or a singular one (C alone)
+_NAN_HINT = (
+    "the system's matrix holds infinities (a dense 1 / M divides by its zeros off the diagonal) or is singular "
+    "(C alone: its rows sum to zero); solve (M - tau C) P' = M P, positive definite for every tau >= 0"
+)
+
+
 def _solve(A, B):
     return sla.spsolve(sp.csc_matrix(A), B)
 
@@ -46,7 +53,7 @@ def implicit_step(fn):
         # tau lam_max about 3: far from both 0 (where every scheme agrees) and the explicit limit 2
         tau = 3.0 / np.abs(C.diagonal() / M.diagonal()).max()
         for P in (V, V + 0.05 * rng.standard_normal(V.shape)):
-            out = positions(call(fn, P.copy(), M.copy(), C.copy(), tau), len(V))
+            out = positions(call(fn, P.copy(), M.copy(), C.copy(), tau), len(V), nan_hint=_NAN_HINT)
             right = _solve(M - tau * C, M @ P)
             atol = AGREE * np.abs(right).max()
 
