@@ -1,6 +1,8 @@
 """Notebook 03's diagrams draw geomlib's own geometry: the hat gradients give the cotangent C,
 the drawn regions have the mixed areas, and the alt texts carry the numbers drawn."""
 
+import re
+
 import matplotlib
 import numpy as np
 import pytest
@@ -51,8 +53,12 @@ def test_circumcentres_are_equidistant_and_regions_sum_to_the_mixed_areas():
 
 
 def test_the_figures_say_what_they_draw():
-    _, alt = d.hat_figure()
+    fig, alt = d.hat_figure()
     assert "6 neighbours" in alt and "C_ij = (cot alpha + cot beta)/2 = " in alt
+    h, L = map(float, re.search(r"h_i = ([\d.]+) over it dotted, so its arrow has length (\d+\.\d+)", alt).groups())
+    assert abs(L * h - 1) < 0.02  # both printed to two decimals
+    edges = [line for line in fig.axes[1].lines + fig.axes[2].lines if line.get_color() == "0.35"]
+    assert edges and all(line.get_linestyle() == "-" for line in edges)  # no edge dashed by the style's cycle
     V, F, i = d.ring_mesh(0.3, 2)
     _, alt = d.voronoi_figure()
     assert f"its area {mixed_areas(V, F)[i]:.3f} is the mixed area" in alt
@@ -84,6 +90,31 @@ def test_the_convergence_figure_shows_every_slope_once_and_says_them():
         for st in ("median", "max")
     }
     fig, alt = error_figure(rows, slopes)
+    styles = {
+        t.get_label().split(",")[0]: (t.get_marker(), t.get_color())
+        for ax in fig.axes
+        for t in ax.lines
+        if "," in t.get_label()
+    }
+    assert styles["a"] != styles["b"]
     labels = [t.get_text() for ax in fig.axes for t in ax.get_legend().get_texts()]
     assert "a, median: slope 2.00" in labels and "a, max: slope 0.00" in labels
     assert "H a 2.00 / 0.00" in alt and "regular and jittered meshes" in alt and "10 to 160 vertices" in alt
+
+
+def test_an_area_rule_keeps_its_marker_in_the_H_and_the_K_panels():
+    from geomlib.teaching.convergence import error_figure
+
+    keys = [("H", "uniform"), ("H", "cotan, barycentric"), ("H", "cotan, mixed"), ("K", "barycentric"), ("K", "mixed")]
+    rows = {"regular": [{"n": 10 * 4**s, "ell": e, **{k: (e**2, 0.1) for k in keys}} for s, e in enumerate([0.2, 0.1])]}
+    slopes = {("regular", k, st): 2.0 for k in keys for st in ("median", "max")}
+    fig, _ = error_figure(rows, slopes)
+    seen = {}
+    for ax in fig.axes:
+        for line in ax.lines:
+            if ", median" in line.get_label():
+                rule = line.get_label().split(", median")[0].split(", ")[-1]
+                seen.setdefault(rule, set()).add((line.get_marker(), line.get_color()))
+    assert set(seen) == {"uniform", "barycentric", "mixed"}
+    assert all(len(v) == 1 for v in seen.values())  # the same marker and colour in both panels
+    assert len({next(iter(v)) for v in seen.values()}) == 3

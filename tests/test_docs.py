@@ -274,7 +274,10 @@ def test_the_picture_is_geomlibs_own_still_and_small(tmp_path):
     assert picture.stat().st_size < IMAGE_BYTES
     out = tmp_path / "front.png"
     subprocess.run([sys.executable, str(ROOT / "tools" / "make_front_image.py"), "--out", str(out)], check=True)
-    assert out.read_bytes() == picture.read_bytes(), "docs/images/front.png is not what tools/make_front_image.py makes"
+    assert out.read_bytes() == picture.read_bytes(), (
+        "docs/images/front.png is not what tools/make_front_image.py makes now (the stills changed?): "
+        "run python tools/make_front_image.py and commit the picture"
+    )
 
 
 def _stated_minutes(path):

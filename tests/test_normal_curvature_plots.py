@@ -4,7 +4,12 @@ import matplotlib
 import numpy as np
 import pytest
 
-from geomlib.teaching.normal_curvature_plots import normal_section, normal_section_figure
+from geomlib.teaching.normal_curvature_plots import (
+    kappa_turn_figure,
+    normal_section,
+    normal_section_figure,
+    polar_and_dupin_figure,
+)
 
 matplotlib.use("Agg")
 
@@ -38,3 +43,16 @@ def test_the_figure_says_what_it_shows():
     texts = {t.get_text() for t in fig.axes[0].texts}
     assert {"$p_u$", "$p_v$", r"$t(\varphi)$", "$n$", r"$\varphi$"} <= texts
     assert "phi = 40 degrees" in alt and "kappa_n = 2.850" in alt and "1/kappa_n = 0.351" in alt
+
+
+@pytest.mark.parametrize("b, c, labels", [(0.7, 0.5, 2), (0.5, 0.5, 1), (0.5, 0.505, 1)])
+def test_the_two_principal_labels_never_print_over_each_other(b, c, labels):
+    fig, _ = kappa_turn_figure(1.0, b, c)
+    assert len(fig.axes[0].texts) == labels
+
+
+def test_the_indicatrix_alt_reads_the_plotted_radii():
+    phis = np.linspace(0, 2 * np.pi, 361)
+    kappa = 4 * (np.cos(phis) ** 2 / 0.49 + np.sin(phis) ** 2 / 0.25)  # four times a = 1, b = 0.7, c = 0.5
+    _, alt = polar_and_dupin_figure(phis, kappa, 1.0, 0.7, 0.5)
+    assert "semi-axes 0.350 along p_u and 0.250 along p_v" in alt

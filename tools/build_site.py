@@ -774,7 +774,8 @@ li {{ margin: 0.4em 0; }}
 <main id="site-content" tabindex="-1">
 <h1>{title}</h1>
 <p>Every notebook of the workbook, run with its default parameters. The 3D views
-turn in the page: drag to orbit, scroll to zoom, right-drag to pan. The main
+turn in the page: drag to orbit, scroll to zoom, right-drag to pan; or Tab to a view and
+use the arrow keys to turn it, Shift + arrow keys to pan, + and - to zoom, 0 to reset. The main
 sliders move the views here too: they snap to values computed when the site was
 built. Other controls recompute only in JupyterLab; here they show their default value.</p>
 <ol>

@@ -62,7 +62,7 @@ def plot_style():
     """Matplotlib settings of the workbook's plots: the colour cycle :data:`PLOT_COLOURS`
     with a line style of its own per colour (:data:`PLOT_LINESTYLES`), ``C0``-``C4`` being
     those colours. Use as ``with matplotlib.rc_context(plot_style()):``."""
-    from cycler import cycler
+    from matplotlib import cycler  # matplotlib re-exports its own dependency: nothing more to install
 
     return {"axes.prop_cycle": cycler(color=list(PLOT_COLOURS), linestyle=list(PLOT_LINESTYLES))}
 

@@ -4,7 +4,8 @@
 ``{"ell": mean edge length, (quantity, method): (median, maximum) relative error, ...}``;
 ``slopes`` maps ``(family, (quantity, method), "median" | "max")`` to the fitted log-log slope.
 The slopes are shown once, in the legend; the methods are told apart by marker and the two
-statistics by line style, so no series depends on colour alone.
+statistics by line style, so no series depends on colour alone. An area rule keeps its marker and
+colour across panels ("cotan, mixed" for H and "mixed" for K).
 """
 
 import numpy as np
@@ -20,6 +21,11 @@ def _slope(p):
     return "0.00" if text == "-0.00" else text
 
 
+def _rule(method):
+    """The last word of a method's name: "cotan, mixed" and "mixed" share a marker."""
+    return method.split(", ")[-1]
+
+
 def _keys(results):
     first = next(iter(results.values()))[0]
     return [k for k in first if isinstance(k, tuple)]
@@ -31,6 +37,9 @@ def error_figure(results, slopes):
 
     keys = _keys(results)
     quantities = list(dict.fromkeys(q for q, _ in keys))
+    # one marker and colour per rule, named by the method's last word, so that "barycentric" and "mixed"
+    # look the same in the H and in the K panels
+    rules = list(dict.fromkeys(_rule(name) for _, name in keys))
     fig, axes = plt.subplots(
         len(quantities), len(results), figsize=(10, 3.8 * len(quantities)), sharex=True, squeeze=False
     )
@@ -38,7 +47,8 @@ def error_figure(results, slopes):
         ell = np.array([r["ell"] for r in rows])
         for row, q in enumerate(quantities):
             ax = axes[row, col]
-            for m, key in enumerate(k for k in keys if k[0] == q):
+            for key in (k for k in keys if k[0] == q):
+                m = rules.index(_rule(key[1]))
                 for i, (stat, style) in enumerate((("median", "-"), ("max", "--"))):
                     ax.loglog(
                         ell,

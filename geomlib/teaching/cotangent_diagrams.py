@@ -2,7 +2,7 @@
 
 * :func:`hat_figure`: the piecewise-linear hat function psi_i on a one-ring of a jittered flat
   grid, its gradient (constant on each triangle, perpendicular to the edge opposite i, of length
-  1 / height), and an edge ij with the two angles alpha_ij, beta_ij opposite it;
+  1 / height; one triangle shows that edge and the height), and an edge ij with the two angles alpha_ij, beta_ij opposite it;
 * :func:`voronoi_figure`: the mixed (Voronoi) region of a vertex, circumcentres and edge
   midpoints, and an obtuse triangle, whose circumcentre lies outside it, with the plain Voronoi
   pieces and the mixed rule's split A/2, A/4, A/4.
@@ -102,7 +102,8 @@ def _faces_at(F, i):
 def _draw_edges(ax, V, F, **style):
     for f in F:
         xy = V[np.r_[f, f[0]], :2]
-        ax.plot(xy[:, 0], xy[:, 1], **{"color": "0.35", "lw": 0.8, **style})
+        # solid whatever the style's line cycle: a dashed edge would look like it meant something
+        ax.plot(xy[:, 0], xy[:, 1], **{"color": "0.35", "lw": 0.8, "ls": "-", **style})
 
 
 def hat_figure(jitter=0.25, seed=1):
@@ -138,6 +139,14 @@ def hat_figure(jitter=0.25, seed=1):
     )
     ax.plot(*V[i, :2], "ko")
     ax.annotate("i", V[i, :2], xytext=(6, -12), textcoords="offset points", fontsize=12)
+    # in one triangle, the edge opposite i and the height h_i over it: the arrow there has length 1/h_i
+    f0 = F[faces[0]]
+    a, b = (V[v] for v in f0 if v != i)
+    foot = a + (b - a) * np.dot(V[i] - a, b - a) / np.dot(b - a, b - a)
+    h_i = float(np.linalg.norm(V[i] - foot))
+    ax.plot(*np.c_[a, b][:2], "k-", lw=2.5)
+    ax.plot(*np.c_[V[i], foot][:2], "k:", lw=1.2)
+    ax.annotate(r"$h_i$", (V[i, :2] + foot[:2]) / 2, xytext=(4, 4), textcoords="offset points", fontsize=11)
     ax.set(title=r"(b) $\nabla\psi_i$: one constant arrow per triangle", aspect="equal")
     ax.axis("off")
     # the first neighbour whose two triangles with i have no obtuse angle (a positive weight), else the first
@@ -170,7 +179,8 @@ def hat_figure(jitter=0.25, seed=1):
         f"(a) The hat function psi_i as a tent: height 1 at vertex i, 0 at its {len(ring)} neighbours, flat on each "
         f"triangle. (b) Its gradient, one arrow per triangle at the triangle's centre, each perpendicular to the edge "
         f"opposite i and pointing towards i, of length 1/height from {lengths.min():.2f} to {lengths.max():.2f} per "
-        f"length. (c) The edge ij drawn thick in its two triangles, with the angles opposite it, alpha_ij = "
+        f"length; in one triangle the edge opposite i is drawn thick and the height h_i = {h_i:.2f} over it dotted, "
+        f"so its arrow has length {1 / h_i:.2f}. (c) The edge ij drawn thick in its two triangles, with the angles opposite it, alpha_ij = "
         f"{angles[0]:.1f} degrees and beta_ij = {angles[1]:.1f} degrees: C_ij = (cot alpha + cot beta)/2 = {C_ij:.3f}."
     )
     return fig, alt

@@ -69,8 +69,12 @@ def normal_section_figure(a, b, c, phi, u=0.0, v=np.pi / 2):
     corners = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1)]) * size
     tangent_patch = P + corners[:, :1] * (s["p_u"] / np.linalg.norm(s["p_u"])) + corners[:, 1:] * w
     ax.add_collection3d(Poly3DCollection([tangent_patch[:4]], facecolor="0.55", alpha=0.25))
-    normal_patch = P + corners[:, :1] * t + (corners[:, 1:] - size) * n * 0.5
-    ax.add_collection3d(Poly3DCollection([normal_patch[:4]], facecolor="0.8", alpha=0.3))
+    # the normal plane reaches from outside the surface to deep inside, so the section is seen to lie in it;
+    # its dash-dot outline keeps it visible where its face, drawn light, is hidden by the wire mesh
+    normal_patch = P + corners[:, :1] * t + (corners[:, 1:] - 0.4 * size) * n * 0.7
+    ax.add_collection3d(Poly3DCollection([normal_patch[:4]], facecolor="0.85", alpha=0.3))
+    ax.plot(*normal_patch.T, color="black", linestyle="-.", linewidth=0.8)
+    ax.text(*normal_patch[0], r"plane of $t$ and $n$", fontsize=9, ha="right", va="top")
     ax.plot(*s["curve"].T, color="black", linewidth=2.6)
     k = s["kappa_n"]
     angle = np.linspace(0, 2 * np.pi, 181)[:, None]
@@ -84,7 +88,7 @@ def normal_section_figure(a, b, c, phi, u=0.0, v=np.pi / 2):
     mid = P + 0.45 * (np.cos(phi / 2) * t_u + np.sin(phi / 2) * w)
     ax.text(*mid, r"$\varphi$", fontsize=12, ha="center", va="center")
     ax.set_box_aspect((a, b, c))
-    ax.view_init(elev=20, azim=-50)
+    ax.view_init(elev=28, azim=35)  # both planes seen from their face for most phi (edge-on near 145 degrees)
     ax.set_axis_off()
     ax.set_title(r"the normal section at angle $\varphi$ (thick); dashed: circle of radius $1/\kappa_n$", fontsize=10)
     degrees = np.degrees(phi)
@@ -93,7 +97,7 @@ def normal_section_figure(a, b, c, phi, u=0.0, v=np.pi / 2):
         f"At the point ({P[0]:.2f}, {P[1]:.2f}, {P[2]:.2f}) a grey patch of the tangent plane carries the arrows "
         f"p_u (length {np.linalg.norm(s['p_u']):.2f}) and p_v (length {np.linalg.norm(s['p_v']):.2f}) and the unit "
         f"tangent t at phi = {degrees:.0f} degrees from p_u; the arrow n is the outward normal. The plane of n and t "
-        f"cuts the ellipsoid in the thick curve, the normal section; the dashed circle touching it at the point has "
+        f"(a light patch with a dash-dot outline) cuts the ellipsoid in the thick curve, the normal section; the dashed circle touching it at the point has "
         f"radius 1/kappa_n = {1 / k:.3f}, the curvature of the section there being kappa_n = {k:.3f} per length unit."
     )
     return fig, alt
@@ -131,12 +135,14 @@ def polar_and_dupin_figure(phis, kappa, a, b, c):
     ax2.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, fontsize=9, frameon=False)
     fig.tight_layout()
     top, low = int(np.argmax(kappa)), int(np.argmin(kappa))
+    # the indicatrix's semi-axes as plotted: its radius in the directions of p_u (phi = 0) and p_v (phi = pi/2)
+    r_u, r_v = (float(r[np.argmin(np.abs(np.angle(np.exp(1j * (phis - x)))))]) for x in (0, np.pi / 2))
     alt = (
         f"Left, a polar plot of the normal curvature at (a, 0, 0) of the ellipsoid a = {a:g}, b = {b:g}, c = {c:g}: "
         f"the radius is largest, {kappa[top]:.3f}, at phi = {np.degrees(phis[top]):.0f} degrees and smallest, "
         f"{kappa[low]:.3f}, at phi = {np.degrees(phis[low]):.0f} degrees from p_u, repeating every 180 degrees. "
         f"Right, Dupin's indicatrix: the radius 1/sqrt(kappa_n) traces an ellipse with semi-axes "
-        f"{1 / np.sqrt(k_u):.3f} along p_u and {1 / np.sqrt(k_v):.3f} along p_v, on top of the dotted ellipse "
+        f"{r_u:.3f} along p_u and {r_v:.3f} along p_v, on top of the dotted ellipse "
         f"drawn from the principal curvatures a/b^2 = {k_u:.3f} and a/c^2 = {k_v:.3f}."
     )
     return fig, alt
@@ -158,7 +164,11 @@ def kappa_turn_figure(a, b, c, swapped=False):
     ax.plot(phis, kappa, color="black", label=f"$a={a:g}$, $b={b:g}$, $c={c:g}$")
     if swapped:
         ax.plot(phis, ellipsoid_normal_curvature(a, c, b, phis), "-.", color="0.4", label="$b$ and $c$ swapped")
-    for value, style, text in ((a / b**2, "--", r"$a/b^2$ (along $p_u$)"), (a / c**2, ":", r"$a/c^2$ (along $p_v$)")):
+    marks = [(a / b**2, "--", r"$a/b^2$ (along $p_u$)"), (a / c**2, ":", r"$a/c^2$ (along $p_v$)")]
+    if abs(marks[0][0] - marks[1][0]) < 0.06 * max(marks[0][0], marks[1][0]):
+        # closer than a line of text on this axis: one label, or the two would print over each other
+        marks = [(a / b**2, "--", r"$a/b^2 \approx a/c^2$" if b != c else r"$a/b^2 = a/c^2$")]
+    for value, style, text in marks:
         ax.axhline(value, color="0.5", linestyle=style, linewidth=0.9)
         ax.annotate(text, (2 * np.pi, value), xytext=(4, 0), textcoords="offset points", va="center", fontsize=9)
     ax.set_xticks(np.pi * np.arange(0, 2.01, 0.5), ["0", r"$\pi/2$", r"$\pi$", r"$3\pi/2$", r"$2\pi$"])

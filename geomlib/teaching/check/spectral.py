@@ -154,12 +154,12 @@ def _eigenvectors(lam, E, M, C):
     m = M.diagonal()
     scale = np.abs(C).max() * max(np.abs(E).max(), 1e-300)
     if np.abs(C @ E + (m[:, None] * E) * lam).max() > 1e-6 * scale:
-        Z = E / np.sqrt(m)[:, None]  # if E holds Q's eigenvectors y, then M^-1/2 y are the e
-        z_scale = np.abs(C).max() * max(np.abs(Z).max(), 1e-300)
-        if np.abs(C @ Z + (m[:, None] * Z) * lam).max() <= 1e-6 * z_scale:
+        back = E / np.sqrt(m)[:, None]  # if E holds Q's eigenvectors z (section 2), then M^-1/2 z are the e
+        back_scale = np.abs(C).max() * max(np.abs(back).max(), 1e-300)
+        if np.abs(C @ back + (m[:, None] * back) * lam).max() <= 1e-6 * back_scale:
             raise Mistake(
-                "E holds the eigenvectors y of Q = -M^-1/2 C M^-1/2, not transformed back",
-                "the eigenvectors of C e = -lam M e are e = M^-1/2 y: E = Y / sqrt(m)[:, None]",
+                "E holds the eigenvectors z of Q = -M^-1/2 C M^-1/2, not transformed back",
+                "the eigenvectors of C e = -lam M e are e = M^-1/2 z: E = Z / np.sqrt(m)[:, None], m = M.diagonal()",
             )
         raise Mistake(
             "the columns of E are not eigenvectors of C e = -lam M e for these lam (C E + M E diag(lam) is not zero)",
