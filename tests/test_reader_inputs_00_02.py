@@ -137,7 +137,8 @@ def test_course_meshes():
     # the flat grid: rounding noise (|K| <= 8e-13) is no "K < 0", and no H prints as "-0"
     run = ran(NB01, MESH=str(COURSE / "curvatures" / "plane.obj"))
     text = run.outputs_text()
-    assert "uniform H: 0 .. 0" in text and "K: 0 .. 0 1/length^2" in text and "-0 .." not in text
+    assert "(mesh: uniform H), drawn 6.67 x larger; H uniform (length): 0 everywhere, up to rounding" in text
+    assert "K: 0 .. 0 1/length^2" in text and "-0 .." not in text
     assert "0 interior vertices have $K > 0$ (curved like a bowl),\n0 have $K < 0$" in text
     assert "64 have $K = 0$ up to rounding" in text and not run.notes, run.notes
     run = ran(NB01, MESH=str(COURSE / "curvatures" / "lilium_s.obj"), PLANE=str(COURSE / "curvatures" / "plane.obj"))

@@ -123,7 +123,7 @@ def test_notebook7_opens_on_notebook_00_without_dialogs(browser, notebook7_serve
     assert not interruptions, f"a newcomer has to dismiss: {interruptions}"
 
 
-@pytest.mark.parametrize("notebook", ["00_getting_started.ipynb", "05_explicit_smoothing.ipynb"])
+@pytest.mark.parametrize("notebook", ["01_uniform_laplace_curvature.ipynb", "05_explicit_smoothing.ipynb"])
 def test_notebook_in_notebook7(notebook, browser, notebook7_server):
     screenshot_dir = _screenshots(f"notebook7_{Path(notebook).stem}")
     page = browser.new_page(viewport=lablib.VIEWPORT)

@@ -1,6 +1,7 @@
 """Every notebook, run in JupyterLab in a real browser (headless Chromium).
 
-For each notebooks/*.ipynb (new notebooks are picked up automatically):
+For each core notebook notebooks/NN_*.ipynb (new ones are picked up automatically; the
+appendices NNa_*.ipynb run under nbval and as pages of the website, tests/browser/test_site.py):
 
 1. open it, run all cells, wait until every code cell has run and the kernel is idle;
 2. no cell has an error output (stderr text such as tqdm's progress bars is fine);
@@ -24,7 +25,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 # GEOMLIB_NOTEBOOK_DIR runs the same checks on another folder of notebooks
 NOTEBOOK_DIR = Path(os.environ.get("GEOMLIB_NOTEBOOK_DIR", ROOT / "notebooks"))
-NOTEBOOKS = sorted(p.name for p in NOTEBOOK_DIR.glob("*.ipynb"))
+NOTEBOOKS = sorted(p.name for p in NOTEBOOK_DIR.glob("[0-9][0-9]_*.ipynb"))
+# cores whose lesson has no 3D view, or no slider beside one; the test holds that this stays true
+WITHOUT_VIEWS = {"02_fundamental_forms.ipynb": "its pictures are plots; the exact H in 3D is in 02a"}
+WITHOUT_SLIDER = {"00_getting_started.ipynb": "it shows a reader's mesh; the first slider comes in 01"}
 RUN_TIMEOUT = 180  # seconds for one notebook to run top to bottom
 RENDER_TIMEOUT = 30  # seconds for a view to show a picture / react to a slider
 
@@ -59,8 +63,11 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
         assert state["done"] == state["code"], f"only {state['done']} of {state['code']} code cells ran"
 
         # 3: every view shows a picture
-        canvases = lablib.views(page, RENDER_TIMEOUT)
+        canvases = lablib.views(page, 5 if notebook in WITHOUT_VIEWS else RENDER_TIMEOUT)
         count = canvases.count()
+        if notebook in WITHOUT_VIEWS:
+            assert count == 0, f"{notebook} now shows a view: take it out of WITHOUT_VIEWS"
+            return
         assert count >= 1, f"{notebook} shows no MeshView (.geomlib-canvas)"
         for i in range(count):
             canvas = canvases.nth(i)
@@ -79,7 +86,10 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             )
 
         # 4: a slider beside a view changes the picture
-        found = lablib.find_slider(page, RENDER_TIMEOUT)
+        found = lablib.find_slider(page, 5 if notebook in WITHOUT_SLIDER else RENDER_TIMEOUT)
+        if notebook in WITHOUT_SLIDER:
+            assert not found["found"], f"{notebook} now has a slider beside a view: take it out of WITHOUT_SLIDER"
+            return
         assert found["found"], (
             f"{notebook}: no slider shares an ipywidgets box or a cell with a view; put them in one box, "
             "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/teaching/viewer.py)"
@@ -119,15 +129,18 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 continue
             first, second = views.nth(0), views.nth(1)
             turned = followed = False
-            for attempt in range(3):  # a drag can miss while the page is still laying out
+            # a drag can miss while the page is still laying out; a shape that looks the same from
+            # every side (a smooth sphere lit from the camera) shows no change when orbited, so the
+            # last tries pan it (right button), which moves any shape in both linked views
+            for button in ("left", "left", "right"):
                 before_first = lablib.stable_screenshot(first)
                 before_second = lablib.stable_screenshot(second)
                 box = first.bounding_box()
                 x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
                 page.mouse.move(x, y)
-                page.mouse.down()
+                page.mouse.down(button=button)
                 page.mouse.move(x + 90, y + 40, steps=10)
-                page.mouse.up()
+                page.mouse.up(button=button)
                 turned = lablib.wait_for(
                     lambda: lablib.changed_fraction(before_first, lablib.stable_screenshot(first)) > 0.005, 10
                 )
@@ -139,7 +152,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
                 )
                 break
             (screenshot_dir / f"row{r}_linked.png").write_bytes(second.screenshot())
-            assert turned, f"{notebook}: an orbit drag did not turn the first view of side_by_side row {r}"
+            assert turned, f"{notebook}: neither an orbit nor a pan drag moved the first view of side_by_side row {r}"
             assert followed, (
                 f"{notebook}: orbiting the first view of side_by_side row {r} "
                 "did not turn the second (cameras not linked)"
