@@ -9,8 +9,8 @@ part).
 """
 
 import json
-import re
 import os
+import re
 import subprocess
 import sys
 import textwrap
