@@ -10,6 +10,7 @@ Without /usr/bin/chromium the tests are skipped with a message saying how to
 enable them, except on CI (environment variable CI set), where they fail.
 """
 
+import fcntl
 import json
 import os
 import shutil
@@ -80,6 +81,15 @@ def site(browser, tmp_path_factory):
     if given:
         folder = Path(given)
         assert (folder / "pages.json").exists(), f"GEOMLIB_SITE_DIR={given} holds no built site"
+    elif os.environ.get("PYTEST_XDIST_WORKER"):
+        # several worker processes: the first to get here builds the site into the run's shared
+        # temporary folder, the others wait for it and read it (a build takes minutes of both cores)
+        shared = tmp_path_factory.getbasetemp().parent
+        folder = shared / "site"
+        with open(shared / "site.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if not (folder / "pages.json").exists():
+                build_site.build(folder)
     else:
         folder = tmp_path_factory.mktemp("site")
         build_site.build(folder)
