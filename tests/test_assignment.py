@@ -167,3 +167,11 @@ def test_the_release_runs_with_the_stubs_and_reveals_nothing(assignment):
         leaks += [(path.name, *leak) for leak in answer_leaks(nb, exercises_of(nb))]
     assert errors == []
     assert leaks == []
+
+
+def test_notebooks_without_exercises_are_copied_unchanged(assignment):
+    for path in NOTEBOOKS:
+        if path in EXERCISE_NOTEBOOKS:
+            continue
+        solution, released = (nbformat.read(p, as_version=4) for p in (path, assignment / path.name))
+        assert [c.source for c in released.cells] == [c.source for c in solution.cells], path.name
