@@ -260,21 +260,11 @@ def vertex_rms(fn):
     """Check ``fn(V, V_clean) -> float``: sqrt(mean_i |x_i - x_i^clean|^2) / d(V_clean)."""
     checked = []
     for label, V, V_clean in _rms_cases():
-        out = call(fn, V.copy(), V_clean.copy())
-        if isinstance(out, np.ndarray) and out.size != 1:
-            raise Mistake(
-                f"the function returned an array of shape {out.shape}, not one number",
-                "average over all vertices, so the result is a single float",
-                typical=False,
-            )
-        try:
-            value = float(out)
-        except (TypeError, ValueError):
-            raise Mistake(
-                f"the function returned {type(out).__name__}, not a number",
-                "return one float, the RMS distance divided by the diagonal",
-                typical=False,
-            ) from None
+        value = _number(
+            call(fn, V.copy(), V_clean.copy()),
+            "the function",
+            "average over all vertices and return one float, the RMS distance divided by the diagonal",
+        )
         d = bounding_box_diagonal(V_clean)
         e2 = np.einsum("ij,ij->i", V - V_clean, V - V_clean)
         expected = np.sqrt(e2.mean()) / d
@@ -325,19 +315,14 @@ def _experiment(sigma, tau, iterations, seed):
     return {"right": rms(P, V) / d, "noisy": rms(P, W) / d, "noise": rms(W, V) / d, "P": P, "W": W, "d": d}
 
 
-def _number(out, what):
+def _number(out, what, hint="return the one relative error, a float"):
+    """``out`` as a float, or the catch-all Mistake of an array or a non-number that ``what`` returned."""
     if isinstance(out, np.ndarray) and out.size != 1:
-        raise Mistake(
-            f"{what} returned an array of shape {out.shape}, not one number",
-            "return the one relative error, a float",
-            typical=False,
-        )
+        raise Mistake(f"{what} returned an array of shape {out.shape}, not one number", hint, typical=False)
     try:
         return float(out)
     except (TypeError, ValueError):
-        raise Mistake(
-            f"{what} returned {type(out).__name__}, not a number", "return the relative error, a float", typical=False
-        ) from None
+        raise Mistake(f"{what} returned {type(out).__name__}, not a number", hint, typical=False) from None
 
 
 def _near(value, target):
