@@ -16,7 +16,15 @@ _EXPORTS = {
     **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
     **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "steps"),
     **dict.fromkeys(
-        ["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "denoising_comparison", "plot_comparison", "smoothing_sweep"], "sweep"
+        [
+            "EXPLICIT_FRACTIONS",
+            "IMPLICIT_STEPS",
+            "denoising_comparison",
+            "plot_comparison",
+            "plot_sweep",
+            "smoothing_sweep",
+        ],
+        "sweep",
     ),
     **dict.fromkeys(["MeshView", "side_by_side"], "viewer"),
 }
