@@ -104,7 +104,7 @@ def test_normal_noise_moves_along_the_geometry_vertex_normals():
 
 
 def _sphere():
-    from geomlib.teaching.surfaces import icosphere as ico
+    from geomlib.teaching.shapes.surfaces import icosphere as ico
 
     return ico(2)
 

@@ -23,14 +23,14 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
-from ..lessons.laplace import WEIGHTS
-from ..lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
-from ..lessons.noise import add_noise
-from ..lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmoother, explicit_step_limit
-from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.geometry import bounding_box_diagonal
-from ..mesh.validate import check_choice
-from ..numerics.cores import CORES
+from ...lessons.laplace import WEIGHTS
+from ...lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
+from ...lessons.noise import add_noise
+from ...lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmoother, explicit_step_limit
+from ...mesh.errors import MeshError, MeshWarning
+from ...mesh.geometry import bounding_box_diagonal
+from ...mesh.validate import check_choice
+from ...numerics.cores import CORES
 from .steps import absolute_step
 
 __all__ = [
@@ -649,7 +649,7 @@ def plot_taubin_factors(lam_max, tau_shrink, tau_inflate, low):
     """
     import matplotlib.pyplot as plt
 
-    from ..lessons.filters import mode_factor
+    from ...lessons.filters import mode_factor
 
     lam = np.linspace(0.0, lam_max, 200)
     pair = mode_factor(lam, tau_shrink, "taubin", tau_inflate)
