@@ -16,7 +16,14 @@ _EXPORTS = {
     **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
     **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "experiments.steps"),
     **dict.fromkeys(
-        ["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "denoising_comparison", "plot_comparison", "smoothing_sweep"],
+        [
+            "EXPLICIT_FRACTIONS",
+            "IMPLICIT_STEPS",
+            "denoising_comparison",
+            "plot_comparison",
+            "plot_sweep",
+            "smoothing_sweep",
+        ],
         "experiments.sweep",
     ),
     **dict.fromkeys(["MeshView", "side_by_side"], "display.viewer"),
