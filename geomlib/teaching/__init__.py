@@ -19,11 +19,16 @@ _EXPORTS = {
     **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
     **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "experiments.steps"),
     **dict.fromkeys(
-        ["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "denoising_comparison", "plot_comparison", "smoothing_sweep"],
+        [
+            "EXPLICIT_FRACTIONS",
+            "IMPLICIT_STEPS",
+            "denoising_comparison",
+            "smoothing_sweep",
+        ],
         "experiments.sweep",
     ),
     **dict.fromkeys(["MeshView", "setup_display", "side_by_side"], "display.viewer"),
-    "plot_comparison": "figures.denoising_plots",
+    **dict.fromkeys(["plot_comparison", "plot_sweep"], "figures.denoising_plots"),
 }
 
 __all__ = sorted(_EXPORTS)

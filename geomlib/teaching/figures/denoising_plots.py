@@ -1,9 +1,10 @@
-"""The denoising comparison of notebook 07, drawn: heat maps of a metric over step and iterations, one per method
-(the comparison itself is :func:`geomlib.teaching.experiments.sweep.denoising_comparison`)."""
+"""Notebook 07's experiments, drawn: the comparison's heat maps of a metric over step and iterations, one per
+method (:func:`geomlib.teaching.experiments.sweep.denoising_comparison`), and the error curves of a step sweep
+(:func:`geomlib.denoising_sweep`)."""
 
 import numpy as np
 
-__all__ = ["COMPARISON_LABELS", "plot_comparison"]
+__all__ = ["COMPARISON_LABELS", "plot_comparison", "plot_sweep"]
 
 
 #: How the comparison's heat maps name each metric on their colour bar.
@@ -66,5 +67,35 @@ def plot_comparison(result, i, key="rms"):
         + "): "
         + "; ".join(found)
         + "."
+    )
+    return fig, alt
+
+
+def plot_sweep(E, taus, E_noisy=None, unit="length^2"):
+    """The error of a step sweep (:func:`geomlib.denoising_sweep`): one curve per step over the iterations.
+
+    ``E`` (len(taus), N + 1): the error after k = 0..N iterations of each step (log y axis); the
+    smallest is ringed, and ``E_noisy`` (the noisy mesh's error, default ``E[0, 0]``) drawn as a
+    line every curve starts on. Returns ``(fig, alt)``, the alt text built from the plotted numbers.
+    """
+    import matplotlib.pyplot as plt
+
+    E = np.asarray(E, dtype=float)
+    E_noisy = float(E[0, 0] if E_noisy is None else E_noisy)
+    i, k = np.unravel_index(np.argmin(E), E.shape)
+    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    for row, tau in zip(E, taus):
+        ax.plot(np.arange(len(row)), row, label=f"tau = {tau:.3g}")
+    ax.plot(k, E[i, k], "o", ms=12, mfc="none", mec="black", mew=2)
+    ax.axhline(E_noisy, color="grey", ls="--", lw=1)
+    ax.annotate("noisy input", (len(E[0]) - 1, E_noisy), xytext=(0, 4), textcoords="offset points", ha="right")
+    ax.set(yscale="log", xlabel="iterations N", ylabel="error E (vertex RMS / d)")
+    ax.set_title(f"implicit smoothing, one curve per step tau ({unit}): the best is ringed", fontsize=10)
+    ax.legend(fontsize=8)
+    ends = "; ".join(f"tau {tau:.3g}: smallest {row.min():.3g} at N = {int(row.argmin())}" for row, tau in zip(E, taus))
+    alt = (
+        f"The error E over the iteration count for {len(taus)} steps of implicit smoothing, on a log scale, all "
+        f"starting at the noisy mesh's {E_noisy:.3g}. The smallest, {E[i, k]:.3g}, is at tau {taus[i]:.3g} and "
+        f"N = {k} (ringed). Per step: {ends}."
     )
     return fig, alt
