@@ -10,7 +10,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ...lessons.laplace import laplacian
-from .. import surfaces
+from ..shapes import surfaces
 from .catalogue import positions
 from .result import Mistake, call, close, exercise
 

@@ -10,7 +10,7 @@ does not care.
 
 import numpy as np
 
-from ..surfaces import sphere
+from ..shapes.surfaces import sphere
 
 __all__ = [
     "corner_tetrahedron",

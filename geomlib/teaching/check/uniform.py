@@ -186,8 +186,8 @@ K_MISTAKES = [
 K_BOUNDARY_MISTAKES = [
     Wrong(
         "the interior formula is applied at boundary vertices (no boundary rule)",
-        "the fan of a boundary vertex is open: 2 pi - sum of angles measures the missing "
-        "half-plane, not curvature; return NaN there",
+        "the fan of a boundary vertex is open: there 2 pi - sum of angles is pi plus the boundary's turning "
+        "angle, not curvature; return NaN there",
         build=lambda c: c.deficit / c.A,
     ),
     Wrong(
