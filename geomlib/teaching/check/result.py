@@ -206,7 +206,7 @@ class _Rules:
 
     def refusal(self, name, why=""):
         if why:
-            diagnosis = f"the function {why}, which grading refuses, so it earns no points"
+            diagnosis = f"the function {why}; grading refuses it, so it earns no points"
         elif name.startswith("geomlib's") and name.split("`")[1] in {_public(d) for d in self.own}:
             diagnosis = f"the function calls {name}, which this exercise asks you to write, so it earns no points"
         elif name.startswith("geomlib's"):
@@ -228,7 +228,7 @@ def _audit(event, args):
     """Refuse switching the watcher off while the learner's function runs (sys.addaudithook: for good)."""
     hits = _WATCHED[0]
     if hits is not None and event in ("sys.setprofile", "sys.settrace"):
-        hits.append(Refused(event, f"calls {event}, which would switch off the check's watcher"))
+        hits.append(Refused(event, f"calls {event}, which would switch the check's watcher off"))
         raise RuntimeError(f"{event} is refused while an exercise is checked")
 
 
@@ -373,16 +373,7 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
 
         def partial_credit(fn, seed=None):
             """Partial credit: ``fn`` is right, or the first thing wrong is a typical mistake the check names."""
-            result = evaluate(fn, seed)
-            if result.passed:
-                message = "earned: the function passes its check."
-            elif result.partial:
-                message = "earned: what is wrong is a typical mistake, named by the check above."
-            elif not result.written:
-                message = result.message
-            else:
-                message = f"not earned: the check cannot name what is wrong. {result.message}"
-            return _enforce(CheckResult(f"{name}, partial credit", result.partial, message, written=result.written))
+            return _enforce(credit(evaluate(fn, seed)))
 
         check.exercise, check.reread = name, reread
         check.forbid, check.own, check.allow, check.rules = rules.forbid, rules.own, rules.allow, rules.sentence()
@@ -390,6 +381,19 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
         return check
 
     return wrap
+
+
+def credit(result):
+    """The partial-credit verdict on a check's ``result``: right, or a typical mistake the check names."""
+    if result.passed:
+        message = "earned: the function passes its check."
+    elif result.partial:
+        message = "earned: what is wrong is a typical mistake, named by the check above."
+    elif not result.written:
+        message = result.message
+    else:
+        message = f"not earned: the check cannot name what is wrong. {result.message}"
+    return CheckResult(f"{result.name}, partial credit", result.partial, message, written=result.written)
 
 
 def use(fn, check, reference):
