@@ -97,7 +97,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..notebook import graded, strict_claims
-from .fence import Fence, cold_caches, resolve, untrip
+from .fence import GEOMETRY_LIBRARIES, Fence, cold_caches, resolve, untrip
 
 __all__ = [
     "CheckResult",
@@ -225,11 +225,17 @@ _WATCHED = [None]  # while the learner's function runs in this process: the list
 
 
 def _audit(event, args):
-    """Refuse switching the watcher off while the learner's function runs (sys.addaudithook: for good)."""
+    """While the learner's function runs, refuse switching the watcher off and importing a geometry
+    library (sys.addaudithook: installed for good, idle between checks)."""
     hits = _WATCHED[0]
-    if hits is not None and event in ("sys.setprofile", "sys.settrace"):
+    if hits is None:
+        return
+    if event in ("sys.setprofile", "sys.settrace") and sys._getframe(1).f_code.co_filename != threading.__file__:
         hits.append(Refused(event, f"calls {event}, which would switch the check's watcher off"))
         raise RuntimeError(f"{event} is refused while an exercise is checked")
+    if event == "import" and args[0].partition(".")[0] in GEOMETRY_LIBRARIES:
+        hits.append(Refused(args[0], f"imports {args[0]}, a geometry library"))
+        raise ImportError(f"{args[0]} is refused while an exercise is checked")
 
 
 sys.addaudithook(_audit)
@@ -255,6 +261,8 @@ def _watching(fence, hits, namespaces=()):
         yield
     finally:
         _WATCHED[0] = None
+        if threading.getprofile() is not profile and not hits:
+            hits.append(Refused("threading.setprofile", "calls threading.setprofile, which would unwatch its threads"))
         threading.setprofile(None)
         sys.setprofile(previous)
         untrip(swapped)

@@ -38,6 +38,7 @@ from .wire import decode, encode, receive, send
 
 HIT_STATUS = 3
 
+
 def import_statements(source, names):
     """The import statements of a notebook's import cell that bind one of ``names`` (magics and
     the rest of the cell left out): what the solution cells use, without the notebook's plotting."""
