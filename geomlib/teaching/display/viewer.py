@@ -285,7 +285,9 @@ class MeshView:
     width, height : int
         Canvas size in pixels.
     title : str or None
-        Heading shown above the canvas.
+        Heading shown above the canvas: what the view shows, a noun ("signed mean
+        curvature", "the mesh coloured by height"); its text alternative begins
+        "3D view of" the title (without one: "3D view of a mesh of n vertices").
     label : str or None
         Name and unit of the values, shown under the colour bar, e.g. "H (1/length)".
     up : {"z", "y", "x"}
@@ -547,8 +549,8 @@ class MeshView:
 
         Shown under the canvas, given to the still as its alt and to the canvas on the website.
         """
-        what = f"3D view of {self.title}" if self.title else "3D view"
-        text = f"{what}: a mesh of {self._n} vertices and {self._F.shape[0]} faces"
+        mesh = f"a mesh of {self._n} vertices and {self._F.shape[0]} faces"
+        text = f"3D view of {self.title}: {mesh}" if self.title else f"3D view of {mesh}"
         if self._scale != 1.0:
             text += f", drawn {self._scale:.3g} times larger"
         name = self.label or "the values"
@@ -636,6 +638,7 @@ class MeshView:
             distance=(distance or self._distance) / self._scale,
             centre=self._centre,
             cull_back=self.closed,
+            edges=None if self.wireframe is None else edges(self._triangles),
         )
         lo, hi = self.range
         lut = self._lut if self._values is not None and not self.is_zero else None
