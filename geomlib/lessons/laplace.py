@@ -52,6 +52,7 @@ __all__ = [
     "vertex_areas",
     "barycentric_areas",
     "mixed_areas",
+    "voronoi_pieces",
     "face_geometry",
     "uniform_adjacency",
     "WEIGHTS",
@@ -250,6 +251,19 @@ def barycentric_areas(V, F, faces=None):
     return np.bincount(F.ravel(), np.repeat(third, 3), minlength=len(V))  # to each of the 3 corners
 
 
+def voronoi_pieces(V, F, faces=None):
+    """(m, 3) Voronoi piece of each corner, ``1/8 (|e_j|^2 cot theta_j + |e_k|^2 cot theta_k)``, without the obtuse rule.
+
+    The circumcentric region of corner i inside its triangle, a signed area in length^2: it
+    leaves the triangle when the triangle is obtuse, and is negative at corner i exactly when
+    the other two angles differ by more than 90 degrees (notebook 03, section 2).
+    ``faces`` as in :func:`cotangent_matrix`.
+    """
+    l2, _, cot, _ = faces or face_geometry(V, F)
+    lc = l2 * cot
+    return (lc[:, NEXT] + lc[:, PREV]) / 8.0
+
+
 def mixed_areas(V, F, faces=None):
     """(n,) mixed Voronoi vertex areas A_i in length^2 (Meyer et al. 2003, Fig. 4).
 
@@ -266,8 +280,7 @@ def mixed_areas(V, F, faces=None):
     V, F = as_mesh(V, F)
     l2, dblA, cot, degenerate = faces or measured_faces(V, F)
     A = 0.5 * dblA[:, None]
-    lc = l2 * cot
-    voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
+    voronoi = voronoi_pieces(V, F, (l2, dblA, cot, degenerate))
     obtuse = cot < 0  # cot theta < 0 <=> theta > pi/2
     obtuse_triangle = obtuse.any(axis=1, keepdims=True)
     per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
