@@ -5,15 +5,15 @@ triangle, a tetrahedron, a regular grid, a sphere, the ellipsoid) and stops at
 the first thing that is wrong, named as the typical mistake it is ("the sign
 is flipped") with a one-line hint and the derivation to reread.
 
-Writing a check::
+Writing a check: the catalogue of typical mistakes is data, read by one matcher
+(``check.catalogue``: its docstring is the guide, with a complete example)::
 
-    @exercise("uniform_laplacian", reread="section 2 · The uniform Laplacian, derived")
+    @exercise("uniform_laplacian", reread="section 2 · The uniform Laplacian, derived", forbid=(...))
     def uniform_laplacian(fn):
-        M, C = matrix_pair(call(fn, V, F), n=len(V))
-        if close(C, -C_true):
-            raise Mistake("the sign of C is flipped", "C_ii = -valence, C_ij = +1 on edges")
-        ...
-        return ["one triangle", "a regular grid"]        # what was checked
+        cases = uniform_cases(case_rng())                  # placed anew each run
+        answers = run(fn, cases, matrix_pair)              # [(M, C), ...], or a Mistake for a wrong shape
+        judge(C_MISTAKES, cases, [C for _, C in answers], right=lambda c: c.C)
+        return [c.label for c in cases]                    # what was checked
 
 ``exercise`` turns the body into a function ``fn -> CheckResult``:
 
@@ -22,6 +22,15 @@ Writing a check::
   -> ``passed=False``, "not written yet";
 * any other exception from the learner's function -> ``passed=False`` naming it;
 * the body returning -> ``passed=True``, listing what was checked.
+
+Cases that vary from run to run
+-------------------------------
+``case_rng()`` is the generator a check places its cases with (a random similarity,
+a small jitter: ``check.meshes.placed``), from a fresh seed each time the check runs,
+so that answers learned from one run's inputs cannot be replayed. A check that drew it
+ends its message with the seed ("Cases seed 4182."); ``check.NAME(fn, seed=4182)`` or
+the environment variable ``GEOMLIB_CHECK_SEED`` runs those cases again. A right answer
+passes whatever the seed.
 
 Under the test suite's strict mode (``GEOMLIB_STRICT_CLAIMS=1``) a failed check
 of a function that is written (not a stub) raises ``CheckFailed``, so a
@@ -64,6 +73,8 @@ import functools
 import html
 import importlib
 import inspect
+import os
+import secrets
 import sys
 import warnings
 
@@ -78,8 +89,7 @@ __all__ = [
     "Mistake",
     "exercise",
     "call",
-    "matrix_pair",
-    "vector",
+    "case_rng",
     "close",
     "use",
     "reveal",
@@ -269,41 +279,20 @@ def call(fn, *args):
     return out
 
 
+SEED_VARIABLE = "GEOMLIB_CHECK_SEED"
+_SEED = {"asked": None, "used": None}  # of the check being run (checks run one at a time)
+
+
+def case_rng():
+    """The numpy Generator of the running check's cases: one seed per check run (see the module docstring)."""
+    if _SEED["used"] is None:
+        asked = _SEED["asked"] if _SEED["asked"] is not None else os.environ.get(SEED_VARIABLE, "")
+        _SEED["used"] = int(asked) if str(asked).strip() else secrets.randbelow(1_000_000)
+    return np.random.default_rng(_SEED["used"])
+
+
 def _dense(A):
     return A.toarray() if sp.issparse(A) else np.asarray(A)
-
-
-def matrix_pair(out, n):
-    """Check that ``out`` is a pair (M, C) of n x n matrices; return them dense as float arrays."""
-    if not isinstance(out, tuple) or len(out) != 2:
-        raise Mistake(
-            f"the function returned {type(out).__name__}, not the pair (M, C)",
-            "end with `return M, C`, M the diagonal mass matrix and C the weight matrix",
-            typical=False,
-        )
-    M, C = (_dense(A) for A in out)
-    for name, A in (("M", M), ("C", C)):
-        if A.shape == (n,) and name == "M":
-            raise Mistake("M is a vector, not a matrix", "return the diagonal matrix scipy.sparse.diags(areas)")
-        if A.shape != (n, n):
-            raise Mistake(
-                f"{name} has shape {A.shape}, expected ({n}, {n}) for a mesh with {n} vertices",
-                "one row and one column per vertex",
-                typical=False,
-            )
-    return M.astype(float), C.astype(float)
-
-
-def vector(out, n, what="the function"):
-    """Check that ``out`` is a length-n vector of numbers; return it as a float array."""
-    x = np.asarray(out, dtype=float) if not sp.issparse(out) else _dense(out).astype(float)
-    if x.shape not in ((n,), (n, 1), (1, n)):
-        raise Mistake(
-            f"{what} returned shape {x.shape}, expected ({n},): one value per vertex",
-            "return a flat numpy array with one entry per vertex",
-            typical=False,
-        )
-    return x.reshape(n)
 
 
 def close(a, b, rtol=1e-8, atol=1e-10):
@@ -328,6 +317,10 @@ def _enforce(result):
     return result
 
 
+def _seed_said():
+    return "" if _SEED["used"] is None else f" Cases seed {_SEED['used']}."
+
+
 def exercise(name, reread, forbid=(), own=None, allow=()):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
 
@@ -342,10 +335,11 @@ def exercise(name, reread, forbid=(), own=None, allow=()):
     rules = _Rules(forbid, forbid[:1] if own is None else own, allow)
 
     def wrap(body):
-        def evaluate(fn):
-            """The CheckResult of ``fn``; never raises."""
+        def evaluate(fn, seed=None):
+            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises."""
             try:
                 _RULES[0] = rules
+                _SEED.update(asked=seed, used=None)
                 with _quiet_while_graded():
                     checked = body(fn)
             except _NotWritten as exc:
@@ -356,18 +350,18 @@ def exercise(name, reread, forbid=(), own=None, allow=()):
                 return CheckResult(name, False, message, written=False)
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
-                return CheckResult(name, False, message, partial=m.typical)
+                return CheckResult(name, False, message + _seed_said(), partial=m.typical)
             finally:
                 _RULES[0] = None
-            return CheckResult(name, True, "checked on " + ", ".join(checked) + ".")
+            return CheckResult(name, True, "checked on " + ", ".join(checked) + "." + _seed_said())
 
         @functools.wraps(body)
-        def check(fn):
-            return _enforce(evaluate(fn))
+        def check(fn, seed=None):
+            return _enforce(evaluate(fn, seed))
 
-        def partial_credit(fn):
+        def partial_credit(fn, seed=None):
             """Partial credit: ``fn`` is right, or the first thing wrong is a typical mistake the check names."""
-            result = evaluate(fn)
+            result = evaluate(fn, seed)
             if result.passed:
                 message = "earned: the function passes its check."
             elif result.partial:
