@@ -178,7 +178,9 @@ def discuss_pairs(path):
     return pairs
 
 
-RUBRIC = re.compile(r"\*\*Rubric \((\d+) points?\)\.\*\*\n((?:- \(\d+\) [^\n]*\n(?:  [^\n]*\n)*)+)\n\*\*Model answer\.\*\*")
+RUBRIC = re.compile(
+    r"\*\*Rubric \((\d+) points?\)\.\*\*\n((?:- \(\d+\) [^\n]*\n(?:  [^\n]*\n)*)+)\n\*\*Model answer\.\*\*"
+)
 
 
 @pytest.mark.parametrize("path", CORES, ids=[p.name[:2] for p in CORES])
@@ -239,7 +241,11 @@ def test_no_forbidden_routine_is_imported_before_its_exercise(path, name, index)
 
 
 def test_the_import_scan_sees_a_from_import():
-    assert imported_names("from geomlib import add_noise as an, check\nimport numpy as np") == {"add_noise", "an", "check"}
+    assert imported_names("from geomlib import add_noise as an, check\nimport numpy as np") == {
+        "add_noise",
+        "an",
+        "check",
+    }
 
 
 def solution_sizes():
