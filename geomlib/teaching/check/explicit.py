@@ -135,6 +135,7 @@ def _lam(A, M):
         "lessons.smoothing.highest_frequency_mode",
         "numerics.eigen.largest_eigenvalue",
     ),
+    allow=("lessons.laplace.laplacian",),
 )
 def explicit_step_limit(fn):
     """Check ``fn(V, F) -> tau_max`` = 2 / lam_max, lam_max the largest eigenvalue of -M^-1 C
@@ -242,6 +243,7 @@ def _boundary_mask(F, n):
         "lessons.operator.laplace_operator",
     ),
     own=("lessons.smoothing.explicit_smoothing", "lessons.smoothing.ExplicitSmoother"),
+    allow=("lessons.laplace.laplacian", "mesh.topology.boundary_vertices"),
 )
 def smoothing_loop(fn):
     """Check ``fn(V, F, tau, iterations) -> P``: ``iterations`` explicit steps P <- P + tau M^-1 C P

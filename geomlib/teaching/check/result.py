@@ -55,33 +55,49 @@ an exercise run on geomlib's own function in every mode.
 
 Ground rules
 ------------
-As in Jacobson's geometry-processing assignments, each exercise names the geomlib
-routines its answer may not call: its own routine, and whatever computes the answer
-for it (``exercise(..., forbid=("lessons.laplace.laplacian", ...))``, dotted names
-inside geomlib, a class standing for all its methods). While the learner's function
-runs, a profile hook watches for a call of any of them (through a lambda, a helper,
-a cache or another geomlib routine that calls it); one such call fails the check with
-no points, naming the routine. ``check.NAME.rules`` is the sentence the notebook and
-the grading guide print. ``reveal(fn, check.NAME)`` shows geomlib's own routine only
-once ``fn`` passes, so the page a student is handed never shows the answer. Warnings raised by the
-learner's function while nbgrader grades are silenced: nbgrader scores a grade
-cell that wrote to stderr as failed.
+The ground rules are an allow-list (``fence``): an answer may use numpy and scipy
+(``tools``; sympy in 02) and the geomlib routines its exercise hands it
+(``exercise(..., allow=("lessons.curvature.boundary_mask",))``); a call into any other
+geomlib routine or a geometry library (libigl, trimesh, ...) fails the check with no
+points, naming the routine. ``forbid`` names the routines that would compute the answer
+(quoted in the rules' sentence), ``own`` the exercise's own routine. ``check.NAME.rules``
+is the sentence the notebook and the grading guide print. ``reveal(fn, check.NAME)``
+shows geomlib's own routine only once ``fn`` passes, so the page a student is handed
+never shows the answer. Warnings raised by the learner's function while nbgrader grades
+are silenced: nbgrader scores a grade cell that wrote to stderr as failed.
+
+Where the points are decided
+----------------------------
+In the notebook the learner's function runs in the learner's kernel, so the check there
+(a profile hook in this thread and the threads it starts, an audit hook refusing
+``sys.setprofile``/``sys.settrace``, tripwires on libigl's compiled routines) is the
+student's interactive check: fast, with the same diagnoses, but code in the kernel can
+replace the check, its module or numpy. Under nbgrader the points are decided out of the
+kernel's reach: the preprocessor ``geomlib.teaching.grading.JudgeExercises`` runs after
+the notebook executed and hands each exercise to ``judge``, a fresh process holding the
+check and its reference answers, which calls the student's function in a ``sandbox``
+process through a pipe carrying plain data (arrays, sparse matrices as their components,
+sympy as its srepr). The sandbox runs only the notebook's imports and the solution cells,
+behind a fence the student's code cannot switch off (an audit hook ends the process on a
+forbidden entry, thread, process, setprofile or compile). ``copies`` flags a function whose
+syntax tree, names aside, is geomlib's routine (no points) or the solution notebook's
+(flagged for the grader). See docs/grading.md.
 """
 
 import contextlib
 import functools
 import html
-import importlib
-import inspect
 import os
 import secrets
 import sys
+import threading
 import warnings
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..notebook import graded, strict_claims
+from .fence import Fence, cold_caches, resolve, untrip
 
 __all__ = [
     "CheckResult",
@@ -162,62 +178,42 @@ class CheckResult:
         display({"text/plain": repr(self), "text/html": self._repr_html_()}, raw=True)
 
 
-def _resolve(dotted):
-    """The object a dotted name inside geomlib stands for ("lessons.laplace.laplacian")."""
-    module, _, name = dotted.rpartition(".")
-    return getattr(importlib.import_module(f"geomlib.{module}"), name)
+class Refused(Exception):
+    """The learner's function entered fenced code (``name``) or did what grading refuses (``why``)."""
 
-
-def _entry_points(dotted):
-    """{code object or id of a callable: public name} by which a call of ``dotted`` shows in a profile."""
-    target = _resolve(dotted)
-    members = [m for m in vars(target).values()] if isinstance(target, type) else [target]
-    found = {}
-    for member in members:
-        f = member.fget if isinstance(member, property) else getattr(member, "__func__", member)
-        if not callable(f):
-            continue
-        found[id(f)] = dotted  # a C-level wrapper (functools.lru_cache) shows as a "c_call" of itself
-        code = getattr(inspect.unwrap(f), "__code__", None)
-        if code is not None:
-            found[code] = dotted
-    return found
+    def __init__(self, name, why=""):
+        super().__init__(name)
+        self.name, self.why = name, why
 
 
 class _Rules:
-    """The ground rules of one exercise: the geomlib routines its answer may not call."""
+    """The ground rules of one exercise: an allow-list (the module docstring of ``fence``)."""
 
-    def __init__(self, forbid, own, allow=()):
-        self.forbid, self.own, self.allow = tuple(forbid), tuple(own), tuple(allow)
-        self._watch = None
-
-    def watch(self):
-        if self._watch is None:  # resolved on first use: a check module imports no lesson it forbids
-            self._watch = {}
-            for dotted in self.forbid:
-                self._watch.update(_entry_points(dotted))
-        return self._watch
+    def __init__(self, forbid, own, allow=(), tools=("numpy", "scipy")):
+        self.forbid, self.own, self.allow, self.tools = tuple(forbid), tuple(own), tuple(allow), tuple(tools)
+        self.fence = Fence(self.allow)
 
     def sentence(self):
-        if not self.forbid:
-            return "Any geomlib routine may be used."
-        names = ", ".join(f"`{_public(d)}`" for d in self.forbid)
-        tools = "numpy, scipy or sympy"
+        tools = ", ".join(self.tools[:-1]) + f" and {self.tools[-1]}"
         if self.allow:
-            tools += " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
-        return f"Ground rules: write it yourself with {tools}; do not call geomlib's {names}."
+            tools = ", ".join(self.tools) + " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
+        named = ", ".join(f"`{_public(d)}`" for d in self.forbid)
+        such = f" (such as {named})" if named else ""
+        return (
+            f"Ground rules: write it with {tools}. Any other geomlib routine{such}, a geometry library "
+            "(libigl, trimesh, gpytoolbox, ...) or a copy of geomlib's code earns no points."
+        )
 
-    def refusal(self, dotted):
-        why = (
-            "which this exercise asks you to write"
-            if dotted in self.own
-            else "which computes this exercise's answer for you"
-        )
-        return Mistake(
-            f"the function calls geomlib's `{_public(dotted)}`, {why}, so it earns no points",
-            self.sentence().rstrip("."),
-            typical=False,
-        )
+    def refusal(self, name, why=""):
+        if why:
+            diagnosis = f"the function {why}, which grading refuses, so it earns no points"
+        elif name.startswith("geomlib's") and name.split("`")[1] in {_public(d) for d in self.own}:
+            diagnosis = f"the function calls {name}, which this exercise asks you to write, so it earns no points"
+        elif name.startswith("geomlib's"):
+            diagnosis = f"the function calls {name}, which this exercise does not hand you, so it earns no points"
+        else:
+            diagnosis = f"the function calls {name}: a geometry library computes it for you, so it earns no points"
+        return Mistake(diagnosis, self.sentence().rstrip("."), typical=False)
 
 
 def _public(dotted):
@@ -225,57 +221,72 @@ def _public(dotted):
 
 
 _RULES = [None]  # the rules of the exercise being checked (checks run one at a time)
+_WATCHED = [None]  # while the learner's function runs in this process: the list its refusals go to
+
+
+def _audit(event, args):
+    """Refuse switching the watcher off while the learner's function runs (sys.addaudithook: for good)."""
+    hits = _WATCHED[0]
+    if hits is not None and event in ("sys.setprofile", "sys.settrace"):
+        hits.append(Refused(event, f"calls {event}, which would switch off the check's watcher"))
+        raise RuntimeError(f"{event} is refused while an exercise is checked")
+
+
+sys.addaudithook(_audit)
 
 
 @contextlib.contextmanager
-def _watching(watch, hits):
-    """Record the first forbidden routine entered while the block runs (sys.setprofile)."""
+def _watching(fence, hits, namespaces=()):
+    """Record the first entry into fenced code while the block runs, in this thread and the threads
+    it starts (sys.setprofile, threading.setprofile); wrap the geometry libraries' compiled routines."""
 
-    def profile(frame, event, arg):
-        if hits:
-            return
-        if event == "call":
-            name = watch.get(frame.f_code)
-        elif event == "c_call":
-            name = watch.get(id(arg))
-        else:
-            return
-        if name is not None:
-            hits.append(name)
+    def on_hit(name):
+        if not hits:
+            hits.append(Refused(name))
 
+    profile = fence.profile(on_hit)
+    cold_caches()
+    swapped = fence.tripwires(namespaces, on_hit)
     previous = sys.getprofile()
     sys.setprofile(profile)
+    threading.setprofile(profile)
+    _WATCHED[0] = hits
     try:
         yield
     finally:
+        _WATCHED[0] = None
+        threading.setprofile(None)
         sys.setprofile(previous)
+        untrip(swapped)
 
 
 def call(fn, *args):
     """Call the learner's function under the exercise's ground rules; turn its exceptions into a diagnosis."""
     rules, hits = _RULES[0], []
     try:
-        if rules is not None and rules.forbid:
-            with _watching(rules.watch(), hits):
+        if rules is not None:
+            with _watching(rules.fence, hits, [getattr(fn, "__globals__", {})]):
                 out = fn(*args)
         else:
             out = fn(*args)
+    except Refused as exc:  # reported by the grading sandbox
+        raise rules.refusal(exc.name, exc.why) from None
     except NotImplementedError as exc:
         if hits:
-            raise rules.refusal(hits[0]) from None
+            raise rules.refusal(hits[0].name, hits[0].why) from None
         raise _NotWritten(str(exc)) from None
     except Mistake:
         raise
     except Exception as exc:  # the learner's code may raise anything; name it
         if hits:
-            raise rules.refusal(hits[0]) from None
+            raise rules.refusal(hits[0].name, hits[0].why) from None
         raise Mistake(
-            f"the function raised {type(exc).__name__}: {exc}",
+            f"the function raised {getattr(exc, 'kind', type(exc).__name__)}: {exc}",
             "run it on the small example in the cell above and read the traceback",
             typical=False,
         ) from None
     if hits:
-        raise rules.refusal(hits[0])
+        raise rules.refusal(hits[0].name, hits[0].why)
     return out
 
 
@@ -321,18 +332,19 @@ def _seed_said():
     return "" if _SEED["used"] is None else f" Cases seed {_SEED['used']}."
 
 
-def exercise(name, reread, forbid=(), own=None, allow=()):
+def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy")):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
 
-    ``forbid``: dotted names inside geomlib of the routines the answer may not call;
-    ``own``: those of them that are the exercise's own routine, revealed by ``reveal``
-    (default: the first); ``allow``: geomlib routines the exercise hands the student
-    (named in the ground rules' sentence; any routine not forbidden may be called).
+    The ground rules are an allow-list: the answer may use ``tools`` and the geomlib
+    routines ``allow`` names (dotted names inside geomlib); any other geomlib routine or a
+    geometry library is refused. ``forbid``: the routines that would compute the answer,
+    named in the rules' sentence; ``own``: those that are the exercise's own routine,
+    revealed by ``reveal`` (default: the first of ``forbid``).
     """
     overlap = set(forbid) & set(allow)
     if overlap:
         raise ValueError(f"exercise {name}: {sorted(overlap)} both forbidden and allowed")
-    rules = _Rules(forbid, forbid[:1] if own is None else own, allow)
+    rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools)
 
     def wrap(body):
         def evaluate(fn, seed=None):
@@ -411,8 +423,8 @@ def reveal(fn, check):
     if result.passed:
         print(f"Your {getattr(fn, '__name__', 'function')} passes its check. geomlib's own, to compare with yours:")
         for dotted in check.own[1:]:
-            display(show_source(_resolve(dotted)))
-        return show_source(_resolve(check.own[0]))
+            display(show_source(resolve(dotted)))
+        return show_source(resolve(check.own[0]))
     print(
         f"geomlib's own {_public(check.own[0])} is shown here once your "
         f"{getattr(fn, '__name__', 'function')} passes its check above: write yours first."
