@@ -638,6 +638,7 @@ SWEEP_MISTAKES = [
         "teaching.experiments.sweep.smoothing_sweep",
         "teaching.experiments.sweep.denoising_comparison",
     ),
+    allow=("lessons.laplace.laplacian",),
 )
 def denoising_sweep(fn):
     """Check ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` (section 5 of notebook 07)."""
