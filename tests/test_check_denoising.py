@@ -52,11 +52,11 @@ WRONG_NOISE = {
     ),
     "in place": (
         lambda V, F, sigma, seed: V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed)),
-        "modified in place",
+        "changed its input V in place",
     ),
     "in place, copy returned": (
         lambda V, F, sigma, seed: np.copy(V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed))),
-        "modified in place",
+        "changed its input V in place",
     ),
     "not seeded": (
         lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.standard_normal(V.shape),
