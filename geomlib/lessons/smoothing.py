@@ -212,7 +212,8 @@ def _check_iterations(iterations):
 
 
 def _tau_or_step(tau, step):
-    """``tau``, or ``step``, the name DESIGN.md's contract gives the same argument."""
+    """``tau``, or ``step``, the same argument under the name of the course's interface
+    (``explicit_smoothing(V, F, step, iterations)``), kept for callers that pass it by that name."""
     if step is None:
         return tau
     if tau is not None:
@@ -269,7 +270,7 @@ def explicit_smoothing(
     iterations : int >= 0
     weights : "cotan" or "uniform"
     step : float >= 0, optional
-        Another name for ``tau`` (the one DESIGN.md's contract uses).
+        Another name for ``tau``, the course's name for it (``explicit_smoothing(V, F, step=..., iterations=...)``).
     step_fraction : float >= 0, optional
         The step as a fraction of the stability limit (scale-free): below 1 is stable.
     area : "barycentric" or "mixed"
@@ -585,7 +586,7 @@ def implicit_smoothing(
     iterations : int >= 0
     weights : "cotan" or "uniform"
     step : float >= 0, optional
-        Another name for ``tau`` (the one DESIGN.md's contract uses).
+        Another name for ``tau``, the course's name for it (``implicit_smoothing(V, F, step=..., iterations=...)``).
     area : "barycentric" or "mixed"
     boundary_condition : "fixed" (default) or "free"
         Fixed: boundary vertices keep their positions and the interior block

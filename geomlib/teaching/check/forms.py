@@ -204,6 +204,7 @@ def forms_cases(rng):
     "fundamental_forms",
     reread="The definitions and Steps 1-2 · the tangents p_u, p_v and the inward normal p_u x p_v / |p_u x p_v| = -n",
     forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
+    tools=("sympy", "numpy", "scipy"),
 )
 def fundamental_forms(fn):
     """Check ``fn(a, b, c, u, v) -> (I, II)`` (or the six E, F, G, e, f, g) for the ellipsoid, by value."""
@@ -368,6 +369,7 @@ def kappa_cases(rng):
         "lessons.symbolic.ellipsoid",
     ),
     own=("lessons.symbolic.forms_normal_curvature", "lessons.symbolic.unit_tangent"),
+    tools=("numpy", "scipy", "sympy"),
 )
 def normal_curvature(fn):
     """Check ``fn(forms, a, b, c, u, v, phi) -> kappa_n``: forms(a, b, c, u, v) -> (I, II) in sympy; numbers in."""

@@ -47,9 +47,6 @@ __all__ = [
     "COMPARISON_GRIDS",
     "DenoisingComparison",
     "denoising_comparison",
-    "plot_comparison",
-    "plot_sweep",
-    "plot_taubin_factors",
 ]
 
 #: The smoothing methods a scheme can name.
@@ -238,7 +235,8 @@ def smoothing_sweep(
     -------
     SmoothingSweep
     """
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    if comparison is None:
+        comparison = MeshComparison(V_clean, F)
     iterations = np.asarray(sorted(set(int(k) for k in iterations)), dtype=np.int64)
     if len(iterations) == 0 or iterations[0] < 1:
         raise MeshError("iterations must be positive whole numbers")
@@ -255,7 +253,7 @@ def smoothing_sweep(
         bar = tqdm(total=runs, desc="smoothing sweep")
 
     def sweep(levels, bar):
-        _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterations, bar)
+        _sweep_levels(comparison, out, levels, seed, direction, schemes, step_values, iterations, bar)
 
     def rows(levels):
         found = {("values", k): v[levels] for k, v in out.values.items()}
@@ -287,7 +285,7 @@ def _run_levels(sweep, rows, put, count, out, bar, workers):
     out.seconds = time.perf_counter() - start
 
 
-def _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterations, bar):
+def _sweep_levels(comparison, out, levels, seed, direction, schemes, step_values, iterations, bar):
     """The runs of :func:`smoothing_sweep` at the noise levels ``levels`` (indices), recorded into ``out``."""
     where = {int(k): l for l, k in enumerate(iterations)}
     last = int(iterations[-1])
@@ -295,22 +293,22 @@ def _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterati
     # M - step C, serves every noise level (it smooths each noisy mesh from P = Vn)
     shared = {}
     for i in levels:
-        Vn = add_noise(C.V_clean, C.F, out.sigmas[i], seed, direction=direction)
-        for key, value in C.evaluate(Vn, hausdorff=False).items():
+        Vn = add_noise(comparison.V_clean, comparison.F, out.sigmas[i], seed, direction=direction)
+        for key, value in comparison.evaluate(Vn, hausdorff=False).items():
             out.noisy[key][i] = value
         for j, (method, weights) in enumerate(schemes):
             smoother = shared.get((method, weights))
             if smoother is None:
-                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
+                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, comparison.F, weights)
                 if method == "implicit" and weights == "uniform":
                     shared[method, weights] = smoother
             for k, value in enumerate(step_values[method]):
-                step = scale_free_step(Vn, C.F, method, weights, value)
+                step = scale_free_step(Vn, comparison.F, method, weights, value)
                 out.steps[i, j, k] = step
 
                 def record(it, P, i=i, j=j, k=k):
                     if it in where:
-                        for name, v in C.evaluate(P, hausdorff=False).items():
+                        for name, v in comparison.evaluate(P, hausdorff=False).items():
                             out.values[name][i, j, k, where[it]] = v
 
                 with warnings.catch_warnings():
@@ -465,7 +463,8 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     for method, weights in grids:
         check_choice("method", method, METHODS + ("taubin",))
         check_choice("weights", weights, WEIGHTS)
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    if comparison is None:
+        comparison = MeshComparison(V_clean, F)
     out = DenoisingComparison(sigmas, grids)
     for steps, counts in out.grids.values():
         if not steps or not counts or min(counts) < 1 or min(steps) <= 0:
@@ -476,7 +475,7 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
 
     def sweep(indices, bar):
         for i, j in (jobs[x] for x in indices):
-            _compare(C, out, i, j, seed)
+            _compare(comparison, out, i, j, seed)
 
     def rows(indices):
         found = {}
@@ -500,21 +499,21 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     return out
 
 
-def _compare(C, out, i, j, seed):
+def _compare(comparison, out, i, j, seed):
     """The runs of :func:`denoising_comparison` of method ``j`` at noise level ``i``, recorded into ``out``."""
-    W = add_noise(C.V_clean, C.F, out.sigmas[i], seed)
-    for key, value in C.evaluate(W, hausdorff=False).items():
+    W = add_noise(comparison.V_clean, comparison.F, out.sigmas[i], seed)
+    for key, value in comparison.evaluate(W, hausdorff=False).items():
         if key in out.noisy:
             out.noisy[key][i] = value
     (method, weights), (steps, counts) = out.methods[j], out.grids[out.methods[j]]
-    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, C.F, weights)
-    out.limits[i, j] = limit = explicit_step_limit(W, C.F, weights)
+    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, comparison.F, weights)
+    out.limits[i, j] = limit = explicit_step_limit(W, comparison.F, weights)
     where = {k: l for l, k in enumerate(counts)}
     for k, fraction in enumerate(steps):
 
         def record(it, P, k=k):
             if it in where:
-                for key, value in C.evaluate(P, hausdorff=False).items():
+                for key, value in comparison.evaluate(P, hausdorff=False).items():
                     if key in out.values:
                         out.values[key][j][i, k, where[it]] = value
 
@@ -545,135 +544,3 @@ def _taubin(smoother, W, tau, counts, callback):
             if not np.abs(P - W).max() <= far:
                 return
             callback(k, P)
-
-
-#: How the comparison's heat maps name each metric on their colour bar.
-COMPARISON_LABELS = {
-    "rms": "E: vertex RMS error / d",
-    "normal_mean": "mean face-normal error (degrees)",
-    "volume_change": "|volume change| (fraction)",
-}
-
-
-def plot_comparison(result, i, key="rms"):
-    """Heat maps of :func:`denoising_comparison` at noise level ``i``: one panel per method.
-
-    Each panel: ``key`` over (step, iteration count), in one unit on every panel (y: the step
-    as a fraction of the explicit limit of the method's operator; x: iterations, Taubin's
-    pairs), on one log colour scale for all panels in the metric's own unit, the unit of the
-    number written at each panel's best cell (ringed); the noisy input's value is marked on
-    the colour bar, so a cell darker than the mark improved on the input. Returns
-    ``(fig, alt)``, the alt text built from the plotted numbers.
-    """
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
-
-    noisy = float(result.noisy[key][i])
-    shown = [np.abs(v[i]) for v in result.values[key]]
-    found = np.concatenate([x[np.isfinite(x) & (x > 0)] for x in shown] + [np.array([noisy] if noisy > 0 else [])])
-    lo, hi = (float(found.min()), float(found.max())) if found.size else (1.0, 1.0)
-    norm = LogNorm(vmin=lo, vmax=max(hi, 10 * lo))
-    fig, axes = plt.subplots(1, len(result.methods), figsize=(3.6 * len(result.methods), 3.3), squeeze=False)
-    found, edge = [], []
-    for ax, (method, weights), values in zip(axes[0], result.methods, shown):
-        steps, counts = result.grids[method, weights]
-        im = ax.imshow(values, cmap="viridis", norm=norm, aspect="auto", origin="lower")
-        b = result.best(i, (method, weights), key)
-        k, l = b["index"]
-        ax.plot(l, k, "o", ms=14, mfc="none", mec="white", mew=2)
-        side = "center" if 0 < l < len(counts) - 2 else ("left" if l == 0 else "right")  # kept inside the panel
-        shift = {"center": 0, "left": -8, "right": 8}[side]
-        ax.annotate(f"{b[key]:.3g}", (l, k), xytext=(shift, 11), textcoords="offset points", ha=side, color="white")
-        ticks = range(0, len(counts), -(-len(counts) // 5))  # at most five labels: they must not run together
-        ax.set_xticks(list(ticks), [str(counts[c]) for c in ticks])
-        ax.set_yticks(range(len(steps)), [f"{s:g}" for s in steps])
-        ax.set_xlabel("shrink/inflate pairs" if method == "taubin" else "iterations")
-        ax.set_title(f"{method}, {weights}", fontsize=10)
-        found.append(f"{method} {weights} {b[key]:.3g} at {b['fraction']:g} of the limit, {b['iterations']} iterations")
-        if not b["inside"]:
-            edge.append(f"{method} {weights}")
-    axes[0, 0].set_ylabel("step / explicit limit")
-    name = COMPARISON_LABELS.get(key, key)
-    bar = fig.colorbar(im, ax=axes, label=f"{name} (log scale)", shrink=0.9)
-    if noisy > 0:  # the input every setting has to beat, on the same scale
-        bar.ax.axhline(noisy, color="black", lw=2)
-        bar.ax.annotate("noisy\ninput", (0, noisy), xytext=(-4, 0), textcoords="offset points", ha="right", va="center")
-    fig.suptitle(f"noise sigma = {result.sigmas[i]:g}: {name} after smoothing, over step and iterations", y=1.04)
-    alt = (
-        f"{len(result.methods)} heat maps at noise sigma {result.sigmas[i]:g}, one per method, of {name} over the "
-        f"step (as a fraction of the explicit limit) and the iteration count, from {lo:.3g} to {hi:.3g} on one log "
-        f"colour scale; the noisy input's {noisy:.3g} is marked on the colour bar. Each method's smallest value ("
-        + (f"on its grid's edge for {' and '.join(edge)}" if edge else "inside its grid")
-        + "): "
-        + "; ".join(found)
-        + "."
-    )
-    return fig, alt
-
-
-def plot_sweep(E, taus, E_noisy=None, unit="length^2"):
-    """The error of a step sweep (:func:`geomlib.denoising_sweep`): one curve per step over the iterations.
-
-    ``E`` (len(taus), N + 1): the error after k = 0..N iterations of each step (log y axis); the
-    smallest is ringed, and ``E_noisy`` (the noisy mesh's error, default ``E[0, 0]``) drawn as a
-    line every curve starts on. Returns ``(fig, alt)``, the alt text built from the plotted numbers.
-    """
-    import matplotlib.pyplot as plt
-
-    E = np.asarray(E, dtype=float)
-    E_noisy = float(E[0, 0] if E_noisy is None else E_noisy)
-    i, k = np.unravel_index(np.argmin(E), E.shape)
-    fig, ax = plt.subplots(figsize=(6.4, 3.6))
-    for row, tau in zip(E, taus):
-        ax.plot(np.arange(len(row)), row, label=f"tau = {tau:.3g}")
-    ax.plot(k, E[i, k], "o", ms=12, mfc="none", mec="black", mew=2)
-    ax.axhline(E_noisy, color="grey", ls="--", lw=1)
-    ax.annotate("noisy input", (len(E[0]) - 1, E_noisy), xytext=(0, 4), textcoords="offset points", ha="right")
-    ax.set(yscale="log", xlabel="iterations N", ylabel="error E (vertex RMS / d)")
-    ax.set_title(f"implicit smoothing, one curve per step tau ({unit}): the best is ringed", fontsize=10)
-    ax.legend(fontsize=8)
-    ends = "; ".join(f"tau {tau:.3g}: smallest {row.min():.3g} at N = {int(row.argmin())}" for row, tau in zip(E, taus))
-    alt = (
-        f"The error E over the iteration count for {len(taus)} steps of implicit smoothing, on a log scale, all "
-        f"starting at the noisy mesh's {E_noisy:.3g}. The smallest, {E[i, k]:.3g}, is at tau {taus[i]:.3g} and "
-        f"N = {k} (ringed). Per step: {ends}."
-    )
-    return fig, alt
-
-
-def plot_taubin_factors(lam_max, tau_shrink, tau_inflate, low):
-    """One Taubin pair against two explicit steps of ``tau_shrink``: the factor per mode over [0, lam_max].
-
-    Lines told apart by style and marker, each labelled; the smooth mode ``low`` marked on both.
-    Returns ``(fig, alt)``, the alt text built from the plotted factors.
-    """
-    import matplotlib.pyplot as plt
-
-    from ...lessons.filters import mode_factor
-
-    lam = np.linspace(0.0, lam_max, 200)
-    pair = mode_factor(lam, tau_shrink, "taubin", tau_inflate)
-    two = mode_factor(lam, tau_shrink, "explicit") ** 2
-    fig, ax = plt.subplots(figsize=(7, 3.4))
-    ax.plot(lam, pair, "-", lw=2, label=f"one Taubin pair ({tau_shrink:g}, {tau_inflate:g})")
-    ax.plot(lam, two, "--", lw=2, label=f"two explicit steps of {tau_shrink:g}")
-    at = [
-        float(mode_factor(low, tau_shrink, "taubin", tau_inflate)),
-        float(mode_factor(low, tau_shrink, "explicit")) ** 2,
-    ]
-    ax.plot([low, low], at, "ko", ms=5)
-    for y, text in zip(at, ("pair", "explicit")):
-        ax.annotate(
-            f"{text}: {y:.3f}", (low, y), xytext=(6, -4 if text == "explicit" else 4), textcoords="offset points"
-        )
-    ax.axhline(0, color="0.5", lw=0.6)
-    ax.set(
-        xlabel=r"eigenvalue $\lambda$ (0: smooth shape, right: fine wiggles)", ylabel="factor kept", xlim=(0, lam_max)
-    )
-    ax.legend(loc="lower left", fontsize=9)
-    alt = (
-        f"Factor kept per mode over the eigenvalues 0 to {lam_max:.3g}: one Taubin pair ({tau_shrink:g}, {tau_inflate:g}) "
-        f"keeps {at[0]:.3f} of the smooth mode at {low:.3g} where two explicit steps keep {at[1]:.3f}; at the top "
-        f"mode the pair keeps {float(pair[-1]):.3f} and the explicit steps {float(two[-1]):.3f}."
-    )
-    return fig, alt
