@@ -5,8 +5,8 @@ placed anew each run), turns what comes back into arrays with a coercion helper,
 asks ONE matcher which entry of its catalogue the answers are::
 
     from ...lessons.laplace import barycentric_areas
-    from .catalogue import Case, Wrong, judge, run, vector
-    from .meshes import grid_3x3, irregular_tetrahedron, placed
+    from .catalogue import Wrong, judge, mesh_cases, run, vector
+    from .meshes import grid_3x3, irregular_tetrahedron
     from .result import case_rng, exercise
 
     AREA_MISTAKES = [
@@ -21,11 +21,10 @@ asks ONE matcher which entry of its catalogue the answers are::
 
     @exercise("vertex_areas", reread="section 2 · Which area?", forbid=("lessons.laplace.barycentric_areas",))
     def vertex_areas(fn):
-        rng = case_rng()                                      # a fresh seed per run, named in the message
-        cases = []
-        for label, (V, F) in (("an irregular tetrahedron", irregular_tetrahedron()), ("a 3 x 3 grid", grid_3x3())):
-            V, F = placed(V, F, rng)                          # moved, scaled, jittered, renumbered
-            cases.append(Case(label, V=V, F=F).but(A=barycentric_areas(V, F)))   # inputs, then facts
+        meshes = (("an irregular tetrahedron", irregular_tetrahedron()), ("a 3 x 3 grid", grid_3x3()))
+        cases = mesh_cases(meshes, case_rng(), lambda V, F: {"A": barycentric_areas(V, F)})
+        # case_rng(): a fresh seed per run, named in the message; each mesh moved, scaled, jittered,
+        # renumbered; a case holds its inputs (c.V, c.F) and the facts the builders read (c.A)
         answers = run(fn, cases, vector)                      # fn(V, F) on copies, coerced to (n,)
         judge(AREA_MISTAKES, cases, answers, right=lambda c: c.A)
         return [c.label for c in cases]                       # what was checked
@@ -62,6 +61,7 @@ case's inputs through ``result.call``, which names an input changed in place.
 import numpy as np
 import scipy.sparse as sp
 
+from .meshes import placed
 from .result import Mistake, call
 
 __all__ = [
@@ -71,6 +71,7 @@ __all__ = [
     "first_mistake",
     "judge",
     "run",
+    "mesh_cases",
     "matrix_pair",
     "vector",
     "positions",
@@ -197,6 +198,13 @@ def judge(catalogue, cases, answers, right, same=agree):
 def run(fn, cases, coerce):
     """``[coerce(fn(*inputs), case.n) for each case]``: the learner's answers, called on copies of the inputs."""
     return [coerce(call(fn, *(_copy(x) for x in case.inputs.values())), case.n) for case in cases]
+
+
+def mesh_cases(meshes, rng, facts=None):
+    """``[Case(label, V=V, F=F).but(**facts(V, F))]`` for each ``(label, (V, F))`` of ``meshes``, placed
+    anew with ``rng`` (``meshes.placed``: moved, scaled, jittered, renumbered)."""
+    cases = [Case(label, **dict(zip("VF", placed(V, F, rng)))) for label, (V, F) in meshes]
+    return cases if facts is None else [c.but(**facts(c.V, c.F)) for c in cases]
 
 
 def _copy(x):
