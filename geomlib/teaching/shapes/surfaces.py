@@ -438,8 +438,9 @@ def saddle_height(x, y, amplitude=0.2, monkey=0.1):
     ``A = amplitude`` (the height of the bumps: ``x (1 - x^2)`` peaks at
     ``2 / (3 sqrt 3)``, hence the factor 27/4), ``B = monkey``. On the square
     [-1, 1]^2 (``size = 2``) the first term has two bumps, two dips, a saddle
-    at the origin and four more on the boundary, like
-    ``sin(pi x) sin(pi y)``; the monkey-saddle term breaks the symmetry.
+    at the origin and eight more on the boundary (the four edge midpoints and
+    the four corners), like ``sin(pi x) sin(pi y)``; the monkey-saddle term
+    breaks the symmetry.
     A polynomial, so that its exact curvature is a rational expression.
     x, y, z in the same length units.
     """
