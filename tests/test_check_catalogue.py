@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from diagnoses import assert_diagnosed, replaying
 
+from geomlib import check
 from geomlib.lessons.laplace import barycentric_areas
 from geomlib.teaching.check.catalogue import (
     Case,
@@ -14,13 +15,14 @@ from geomlib.teaching.check.catalogue import (
     first_mistake,
     judge,
     matrix_pair,
+    mesh_cases,
     number,
     positions,
     run,
     vector,
 )
-from geomlib.teaching.check.meshes import grid_3x3, irregular_tetrahedron, placed
-from geomlib.teaching.check.result import Mistake, case_rng, exercise
+from geomlib.teaching.check.meshes import grid_3x3, irregular_tetrahedron
+from geomlib.teaching.check.result import Mistake, call, case_rng, exercise
 
 # ---------------------------------------------------------------- the module docstring's example, as written there
 AREA_MISTAKES = [
@@ -39,11 +41,8 @@ AREA_MISTAKES = [
 
 
 def example_cases(rng):
-    cases = []
-    for label, (V, F) in (("an irregular tetrahedron", irregular_tetrahedron()), ("a 3 x 3 grid", grid_3x3())):
-        V, F = placed(V, F, rng)
-        cases.append(Case(label, V=V, F=F).but(A=barycentric_areas(V, F)))
-    return cases
+    meshes = (("an irregular tetrahedron", irregular_tetrahedron()), ("a 3 x 3 grid", grid_3x3()))
+    return mesh_cases(meshes, rng, lambda V, F: {"A": barycentric_areas(V, F)})
 
 
 @exercise("vertex_areas", reread="section 2 · Which area?", forbid=("lessons.laplace.barycentric_areas",))
@@ -147,3 +146,61 @@ def test_the_seed_fixes_the_cases_and_is_reported():
         assert result.passed and result.message.endswith(f"Cases seed {seed}."), result.message
         seen.append(example_cases(np.random.default_rng(seed))[0].V)
     assert np.array_equal(seen[0], seen[1]) and not np.allclose(seen[0], seen[2])
+
+
+# ---------------------------------------------------------------- every call confirms the caller's arrays are unchanged
+def test_an_input_changed_in_place_is_named_by_the_learners_own_parameter_name():
+    def shifted(V, F):
+        V -= V.mean(axis=0)  # areas do not care, the caller's V does
+        return third(V, F)
+
+    def sorted_faces(points, faces):
+        faces.sort(axis=1)  # flips half the faces' orientation: areas do not care
+        return third(points, faces)
+
+    result = vertex_areas(shifted)
+    assert_diagnosed(result, "the function changed its input V in place", "V = V.copy()")
+    assert result.partial
+    assert_diagnosed(vertex_areas(sorted_faces), "changed its input faces in place")
+    assert vertex_areas(lambda V, F: third(V.copy(), F)).passed
+
+
+def test_a_smoothing_loop_that_overwrites_the_callers_V_is_named():
+    from geomlib.lessons.laplace import laplacian
+
+    def overwrites(V, F, tau, iterations):
+        M, C = laplacian(V, F)
+        held = np.zeros(len(V), bool)
+        edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+        e, count = np.unique(edges, axis=0, return_counts=True)
+        held[e[count == 1].ravel()] = True
+        for _ in range(iterations):
+            V[~held] += tau * (C @ V)[~held] / M.diagonal()[~held, None]  # the caller's V, step by step
+        return V
+
+    assert_diagnosed(check.smoothing_loop(overwrites), "the function changed its input V in place")
+
+
+# ---------------------------------------------------------------- every check: a wrong type earns nothing, and never a crash
+EXERCISES = sorted(name for name in dir(check) if hasattr(getattr(check, name), "partial_credit"))
+
+
+@pytest.mark.parametrize("name", EXERCISES)
+def test_an_answer_of_the_wrong_type_earns_nothing_in_every_check(name):
+    for returned in (None, "text", (np.zeros(2),), object()):
+        result = getattr(check, name).evaluate(lambda *args, returned=returned: returned)
+        assert not result.passed and not result.partial, (name, returned, result.message)
+
+
+@exercise("a number", reread="section 0")
+def a_number(fn):
+    if float(call(fn)) != 2.0:  # float() of what came back may raise: the check must not
+        raise Mistake("not two", typical=False)
+    return ["two"]
+
+
+def test_an_answer_the_check_cannot_read_is_a_failed_check_without_points():
+    result = a_number.evaluate(lambda: "two")
+    assert_diagnosed(result, "could not be read as an answer (ValueError", "Reread section 0")
+    assert not result.partial and result.written
+    assert a_number.evaluate(lambda: 2).passed

@@ -1,7 +1,5 @@
 """The exercise checks of notebook 07: they accept the reference, and name each typical mistake."""
 
-import time
-
 import numpy as np
 import pytest
 from diagnoses import assert_diagnosed
@@ -53,11 +51,11 @@ WRONG_NOISE = {
     ),
     "in place": (
         lambda V, F, sigma, seed: V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed)),
-        "modified in place",
+        "changed its input V in place",
     ),
     "in place, copy returned": (
         lambda V, F, sigma, seed: np.copy(V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed))),
-        "modified in place",
+        "changed its input V in place",
     ),
     "not seeded": (
         lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.standard_normal(V.shape),
@@ -115,12 +113,10 @@ WRONG_RMS = {
 }
 
 
-def test_reference_noise_passes_quickly():
-    start = time.perf_counter()
+def test_reference_noise_passes():
     result = check.add_noise(noise_reference)
     assert result.passed, result.message
     assert "grid" in result.message
-    assert time.perf_counter() - start < 1.0
 
 
 def test_rng_normal_with_a_scale_passes_too():

@@ -374,8 +374,8 @@ def test_laplacian_measures_the_faces_once(monkeypatch):
     import geomlib.lessons.laplace as laplace
 
     calls = []
-    measure = laplace.face_geometry
-    monkeypatch.setattr(laplace, "face_geometry", lambda V, F: calls.append(1) or measure(V, F))
+    measure = laplace.FaceGeometry.of
+    monkeypatch.setattr(laplace.FaceGeometry, "of", lambda V, F: calls.append(1) or measure(V, F))
     V, F = surfaces.sphere(1.0, subdivisions=2).V, surfaces.sphere(1.0, subdivisions=2).F
     for area in ("barycentric", "mixed"):
         calls.clear()

@@ -5,8 +5,8 @@ placed anew each run), turns what comes back into arrays with a coercion helper,
 asks ONE matcher which entry of its catalogue the answers are::
 
     from ...lessons.laplace import barycentric_areas
-    from .catalogue import Case, Wrong, judge, run, vector
-    from .meshes import grid_3x3, irregular_tetrahedron, placed
+    from .catalogue import Wrong, judge, mesh_cases, run, vector
+    from .meshes import grid_3x3, irregular_tetrahedron
     from .result import case_rng, exercise
 
     AREA_MISTAKES = [
@@ -21,11 +21,10 @@ asks ONE matcher which entry of its catalogue the answers are::
 
     @exercise("vertex_areas", reread="section 2 · Which area?", forbid=("lessons.laplace.barycentric_areas",))
     def vertex_areas(fn):
-        rng = case_rng()                                      # a fresh seed per run, named in the message
-        cases = []
-        for label, (V, F) in (("an irregular tetrahedron", irregular_tetrahedron()), ("a 3 x 3 grid", grid_3x3())):
-            V, F = placed(V, F, rng)                          # moved, scaled, jittered, renumbered
-            cases.append(Case(label, V=V, F=F).but(A=barycentric_areas(V, F)))   # inputs, then facts
+        meshes = (("an irregular tetrahedron", irregular_tetrahedron()), ("a 3 x 3 grid", grid_3x3()))
+        cases = mesh_cases(meshes, case_rng(), lambda V, F: {"A": barycentric_areas(V, F)})
+        # case_rng(): a fresh seed per run, named in the message; each mesh moved, scaled, jittered,
+        # renumbered; a case holds its inputs (c.V, c.F) and the facts the builders read (c.A)
         answers = run(fn, cases, vector)                      # fn(V, F) on copies, coerced to (n,)
         judge(AREA_MISTAKES, cases, answers, right=lambda c: c.A)
         return [c.label for c in cases]                       # what was checked
@@ -52,6 +51,15 @@ The matcher (:func:`first_mistake`; :func:`judge` raises what it finds):
 in catalogue order, so put the specific before the general. ``typical=False`` marks a
 diagnosis that only says *that* something is wrong: no partial credit.
 
+Patterns: an answer with a free part (an eigenvector's sign, the basis of a repeated
+eigenspace) is compared by what defines it, with ``same=`` (a function of answer, expected,
+case); a mistake seen in a property rather than a value is a ``when`` (eigenvalues right but
+unsorted: ``when=lambda lam, right, c: not (np.diff(lam) >= 0).all() and agree(np.sort(lam), right)``;
+one normal draw shared by x, y and z: ``when=lambda X, right, c: np.allclose(*(X - c.V).T[:2])``);
+inputs beyond the mesh (tau, k, sigma, a seed) are inputs of the ``Case``, in the order the
+learner's function takes them; a check that calls the function twice (another seed, another
+count) runs two lists of cases. Several catalogues may be judged in turn (C before M).
+
 Coercion helpers (:func:`matrix_pair`, :func:`vector`, :func:`positions`,
 :func:`eigenpairs`, :func:`number`) turn what the learner returned into float arrays or
 raise a ``Mistake``; a wrong shape or type is never partial credit (``typical=False``),
@@ -62,6 +70,7 @@ case's inputs through ``result.call``, which names an input changed in place.
 import numpy as np
 import scipy.sparse as sp
 
+from .meshes import placed
 from .result import Mistake, call
 
 __all__ = [
@@ -71,6 +80,7 @@ __all__ = [
     "first_mistake",
     "judge",
     "run",
+    "mesh_cases",
     "matrix_pair",
     "vector",
     "positions",
@@ -197,6 +207,13 @@ def judge(catalogue, cases, answers, right, same=agree):
 def run(fn, cases, coerce):
     """``[coerce(fn(*inputs), case.n) for each case]``: the learner's answers, called on copies of the inputs."""
     return [coerce(call(fn, *(_copy(x) for x in case.inputs.values())), case.n) for case in cases]
+
+
+def mesh_cases(meshes, rng, facts=None):
+    """``[Case(label, V=V, F=F).but(**facts(V, F))]`` for each ``(label, (V, F))`` of ``meshes``, placed
+    anew with ``rng`` (``meshes.placed``: moved, scaled, jittered, renumbered)."""
+    cases = [Case(label, **dict(zip("VF", placed(V, F, rng)))) for label, (V, F) in meshes]
+    return cases if facts is None else [c.but(**facts(c.V, c.F)) for c in cases]
 
 
 def _copy(x):

@@ -224,7 +224,6 @@ def _check_areas(fn, asked, reference, hint):
         "lessons.laplace.barycentric_areas",
         "lessons.laplace.vertex_areas",
         "lessons.laplace.laplacian",
-        "lessons.laplace.measured_areas",
     ),
 )
 def vertex_areas(fn):
@@ -241,7 +240,6 @@ def vertex_areas(fn):
         "lessons.laplace.mixed_areas",
         "lessons.laplace.vertex_areas",
         "lessons.laplace.laplacian",
-        "lessons.laplace.measured_areas",
     ),
 )
 def mixed_areas(fn):

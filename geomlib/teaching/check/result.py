@@ -21,6 +21,9 @@ Writing a check: the catalogue of typical mistakes is data, read by one matcher
 * ``NotImplementedError`` from the learner's function (the assignment's stub)
   -> ``passed=False``, "not written yet";
 * any other exception from the learner's function -> ``passed=False`` naming it;
+* an array handed to the learner's function and changed by it -> ``passed=False``, "the
+  function changed its input V in place" (``call`` compares every array argument after
+  each call; V is the learner's own name for it);
 * the body returning -> ``passed=True``, listing what was checked.
 
 Cases that vary from run to run
@@ -87,6 +90,7 @@ syntax tree, names aside, is geomlib's routine (no points) or the solution noteb
 import contextlib
 import functools
 import html
+import inspect
 import os
 import secrets
 import sys
@@ -269,8 +273,9 @@ def _watching(fence, hits, namespaces=()):
 
 
 def call(fn, *args):
-    """Call the learner's function under the exercise's ground rules; turn its exceptions into a diagnosis."""
-    rules, hits = _RULES[0], []
+    """Call the learner's function under the exercise's ground rules; turn its exceptions into a diagnosis,
+    and an array argument it changed in place into the mistake it is."""
+    rules, hits, before = _RULES[0], [], [_dense(a).copy() if _is_array(a) else None for a in args]
     try:
         if rules is not None:
             with _watching(rules.fence, hits, [getattr(fn, "__globals__", {})]):
@@ -295,7 +300,31 @@ def call(fn, *args):
         ) from None
     if hits:
         raise rules.refusal(hits[0].name, hits[0].why)
+    for k, (a, kept) in enumerate(zip(args, before)):
+        if kept is not None and not np.array_equal(_dense(a), kept, equal_nan=kept.dtype.kind in "fc"):
+            name = _parameter(fn, k)
+            raise Mistake(
+                f"the function changed its input {name} in place",
+                f"work on a copy ({name} = {name}.copy()) or build a new array: the caller's {name} must stay as it was",
+            )
     return out
+
+
+def _is_array(a):
+    return isinstance(a, np.ndarray) or sp.issparse(a)
+
+
+def _parameter(fn, k):
+    """The name of the learner's k-th positional parameter (``V``), or "argument k + 1"."""
+    try:
+        names = [
+            p.name
+            for p in inspect.signature(fn).parameters.values()
+            if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+        ]
+    except (TypeError, ValueError):
+        names = []
+    return names[k] if k < len(names) else f"argument {k + 1}"
 
 
 SEED_VARIABLE = "GEOMLIB_CHECK_SEED"
@@ -371,6 +400,12 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
                 return CheckResult(name, False, message + _seed_said(), partial=m.typical)
+            except Exception as exc:  # what came back could not be read as an answer: no points, never a crash
+                message = (
+                    f"what the function returned could not be read as an answer ({type(exc).__name__}: {exc}). "
+                    f"Hint: return what the exercise asks for, of the shape it states. Reread {reread}."
+                )
+                return CheckResult(name, False, message + _seed_said(), partial=False)
             finally:
                 _RULES[0] = None
             return CheckResult(name, True, "checked on " + ", ".join(checked) + "." + _seed_said())

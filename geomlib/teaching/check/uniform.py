@@ -15,8 +15,8 @@ from ...lessons.curvature import angle_deficit, boundary_mask
 from ...lessons.curvature import gaussian_curvature as geomlib_gaussian_curvature
 from ...lessons.laplace import barycentric_areas, laplacian
 from .area_mistakes import AREA_MISTAKES
-from .catalogue import Case, Wrong, agree, first_mistake, judge, matrix_pair, run, vector
-from .meshes import bump_4x4, corner_tetrahedron, grid_3x3, jittered_icosphere, placed
+from .catalogue import Wrong, agree, first_mistake, judge, matrix_pair, mesh_cases, run, vector
+from .meshes import bump_4x4, corner_tetrahedron, grid_3x3, jittered_icosphere
 from .result import case_rng, exercise
 
 __all__ = ["gaussian_curvature", "uniform_laplacian"]
@@ -26,29 +26,27 @@ _C_RULE = "C_ij = 1 for each edge ij (however many triangles share it), C_ii = -
 _M_RULE = "M = diag(valence), the number of neighbours of each vertex"
 
 
-def uniform_case(label, V, F):
-    """A case of ``uniform_laplacian`` with the facts its catalogue reads: the right dense M and C, the
-    adjacency A (1 per edge), D (how many triangles list i -> j), the triangles at each vertex, the cotangent pair."""
+def _uniform_facts(V, F):
+    """The right dense M and C, the adjacency A (1 per edge), D (how many triangles list i -> j), the
+    triangles at each vertex, the cotangent pair."""
     n = len(V)
     M, C = (X.toarray() for X in laplacian(V, F, weights="uniform"))
     D = np.zeros((n, n))
     for a, b in ((0, 1), (1, 2), (2, 0)):
         np.add.at(D, (F[:, a], F[:, b]), 1.0)
     M_cot, C_cot = (X.toarray() for X in laplacian(V, F))
-    return Case(label, V=V, F=F).but(
-        M=M, C=C, A=C - np.diag(np.diag(C)), valence=np.diag(M), D=D, M_cot=M_cot, C_cot=C_cot,
-        triangles=np.bincount(F.ravel(), minlength=n).astype(float),
-    )  # fmt: skip
+    triangles = np.bincount(F.ravel(), minlength=n).astype(float)
+    return dict(
+        M=M, C=C, A=C - np.diag(np.diag(C)), valence=np.diag(M), D=D, M_cot=M_cot, C_cot=C_cot, triangles=triangles
+    )
+
+
+_TETRAHEDRON, _ICOSPHERE = ("a tetrahedron", corner_tetrahedron()), ("a jittered icosphere", jittered_icosphere())
 
 
 def uniform_cases(rng):
     """The cases of ``uniform_laplacian``, placed with ``rng``."""
-    meshes = (
-        ("a tetrahedron", corner_tetrahedron()),
-        ("a 3 x 3 grid", grid_3x3()),
-        ("a jittered icosphere", jittered_icosphere()),
-    )
-    return [uniform_case(label, *placed(V, F, rng)) for label, (V, F) in meshes]
+    return mesh_cases((_TETRAHEDRON, ("a 3 x 3 grid", grid_3x3()), _ICOSPHERE), rng, _uniform_facts)
 
 
 C_MISTAKES = [
@@ -120,26 +118,12 @@ def uniform_laplacian(fn):
     return [c.label for c in cases]
 
 
-def curvature_case(label, V, F):
-    """A case of ``gaussian_curvature`` with the facts its catalogue reads: the right K, the barycentric
-    areas A, the angle deficit and the interior vertices."""
-    return Case(label, V=V, F=F).but(
-        K=geomlib_gaussian_curvature(V, F),
-        A=barycentric_areas(V, F),
-        deficit=angle_deficit(V, F),
-        inner=~boundary_mask(V, F),
-    )
-
-
 def curvature_cases(rng):
     """The cases of ``gaussian_curvature``, placed with ``rng``: the bump is open, so that interior K is
     clearly non-zero and the boundary rule matters (valences 2 to 4 along its boundary, 6 inside)."""
-    meshes = (
-        ("a tetrahedron", corner_tetrahedron()),
-        ("a bump on a 4 x 4 grid", bump_4x4()),
-        ("a jittered icosphere", jittered_icosphere()),
-    )
-    return [curvature_case(label, *placed(V, F, rng)) for label, (V, F) in meshes]
+    meshes = (_TETRAHEDRON, ("a bump on a 4 x 4 grid", bump_4x4()), _ICOSPHERE)
+    facts = dict(K=geomlib_gaussian_curvature, A=barycentric_areas, deficit=angle_deficit, boundary=boundary_mask)
+    return mesh_cases(meshes, rng, lambda V, F: {name: f(V, F) for name, f in facts.items()})
 
 
 # Legitimate rounding: pi to 7 digits moves a deficit by 7e-7, single-precision angles by about 1e-6. K is
@@ -216,11 +200,11 @@ def gaussian_curvature(fn):
     """Check ``fn(V, F) -> (n,)``: K_i = (2 pi - sum of angles) / (a third of the incident areas), NaN on the boundary."""
     cases = curvature_cases(case_rng())
     Ks = run(fn, cases, vector)
-    mistake = first_mistake(K_MISTAKES, [c.but(where=c.inner) for c in cases], Ks, lambda c: c.K, same_K)
+    mistake = first_mistake(K_MISTAKES, [c.but(where=~c.boundary) for c in cases], Ks, lambda c: c.K, same_K)
     if mistake is not None:
-        valued = [c.label for c, K in zip(cases, Ks) if np.isfinite(K[~c.inner]).any()]
+        valued = [c.label for c, K in zip(cases, Ks) if np.isfinite(K[c.boundary]).any()]
         if not mistake.typical and valued:
             mistake.diagnosis += f"; and boundary vertices of {valued[0]} have values, where K is not defined (NaN)"
         raise mistake
-    judge(K_BOUNDARY_MISTAKES, [c.but(where=~c.inner) for c in cases], Ks, lambda c: c.K, same_K)
+    judge(K_BOUNDARY_MISTAKES, [c.but(where=c.boundary) for c in cases], Ks, lambda c: c.K, same_K)
     return [c.label for c in cases]
