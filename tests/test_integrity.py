@@ -61,29 +61,29 @@ def pasted_copy():
 
 
 def replayed(recorded):
-    """A mixed-areas answer that looks its inputs up among answers recorded from an earlier run."""
-    table = {key: value.tolist() for key, value in recorded.items()}
+    """A uniform Laplacian that looks its inputs up among the answers recorded from an earlier run."""
     return (
-        f"RECORDED = {table!r}\n\n"
-        "def my_mixed_areas(V, F):\n"
+        f"RECORDED = {recorded!r}\n\n"
+        "def my_uniform_laplacian(V, F):\n"
         "    import hashlib\n"
-        "    key = hashlib.sha1(np.ascontiguousarray(V, dtype=float).tobytes()).hexdigest()\n"
-        "    return np.array(RECORDED[key])\n"
+        "    M, C = RECORDED[hashlib.sha1(np.ascontiguousarray(V, dtype=float).tobytes()).hexdigest()]\n"
+        "    return sparse.diags(M), sparse.csr_matrix(np.array(C))\n"
     )
 
 
-def record_mixed_areas(seed):
-    """{sha1 of V: the right mixed areas} of the cases one run of check.mixed_areas draws with ``seed``."""
-    honest = namespace("03")
-    exec(solutions("03")["mixed_areas"], honest)
+def record_uniform_laplacian(seed):
+    """{sha1 of V: (diagonal of M, C as lists)} of the cases one run of check.uniform_laplacian draws with ``seed``."""
+    honest = namespace("01")
+    exec(solutions("01")["uniform_laplacian"], honest)
     recorded = {}
 
     def recorder(V, F):
-        A = honest["my_mixed_areas"](V, F)
-        recorded[hashlib.sha1(np.ascontiguousarray(V, dtype=float).tobytes()).hexdigest()] = A
-        return A
+        M, C = honest["my_uniform_laplacian"](V, F)
+        key = hashlib.sha1(np.ascontiguousarray(V, dtype=float).tobytes()).hexdigest()
+        recorded[key] = (M.diagonal().tolist(), C.toarray().tolist())
+        return M, C
 
-    assert check.mixed_areas.evaluate(recorder, seed=seed).passed
+    assert check.uniform_laplacian.evaluate(recorder, seed=seed).passed
     return recorded
 
 
@@ -140,14 +140,11 @@ CHEATS = {
         "calls geomlib's `voronoi_pieces`",
         "calls geomlib's `voronoi_pieces`",
     ),
-    "check.NAME replaced from a solution cell": (
+    "a replay of recorded answers": (
         "01",
         "uniform_laplacian",
-        "check.uniform_laplacian = lambda fn: None\n"
-        "check.uniform_laplacian.partial_credit = lambda fn: None\n\n"
-        "def my_uniform_laplacian(V, F):\n"
-        "    return reference_uniform_laplacian(V, F)\n",
-        "calls geomlib's `uniform_laplacian`, which this exercise asks you to write",
+        None,
+        "uniform_laplacian: the function raised KeyError",
         None,
     ),
     "geomlib's face_angles for the angle sums": (
@@ -197,6 +194,17 @@ CHEATS = {
         "def my_vertex_areas(V, F):\n"
         "    return np.zeros(len(V))\n",
         "vertex_areas: ",
+        None,
+    ),
+    "check.NAME replaced from a solution cell": (
+        "03",
+        "mixed_areas",
+        "check.mixed_areas = lambda fn: None\n"
+        "check.mixed_areas.partial_credit = lambda fn: None\n\n"
+        "def my_mixed_areas(V, F):\n"
+        "    from geomlib.lessons.laplace import mixed_areas\n"
+        "    return mixed_areas(V, F)\n",
+        "calls geomlib's `mixed_areas`, which this exercise asks you to write",
         None,
     ),
     "numpy and geomlib's comparison monkeypatched": (
@@ -254,7 +262,6 @@ CHEATS = {
         "runs compile on code of its own",
         "calls geomlib's `",
     ),
-    "a replay of recorded answers": ("03", "mixed_areas", None, "mixed_areas: ", None),
 }
 # the three cheating students: each hands in one cheat per exercise of 01 and 03
 CHEATERS = {
@@ -333,11 +340,11 @@ def test_the_wire_carries_plain_data_and_refuses_to_evaluate_anything_else():
 @pytest.mark.slow
 def test_a_replay_passes_the_run_it_was_recorded_from_and_fails_the_next(monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
-    recorded = record_mixed_areas(REPLAY_SEED)
-    ns = namespace("03")
+    recorded = record_uniform_laplacian(REPLAY_SEED)
+    ns = namespace("01")
     exec(replayed(recorded), ns)
-    assert check.mixed_areas.evaluate(ns["my_mixed_areas"], seed=REPLAY_SEED).passed  # a real replay
-    again = check.mixed_areas.evaluate(ns["my_mixed_areas"])
+    assert check.uniform_laplacian.evaluate(ns["my_uniform_laplacian"], seed=REPLAY_SEED).passed  # a real replay
+    again = check.uniform_laplacian.evaluate(ns["my_uniform_laplacian"])
     assert not again.passed and not again.partial and "KeyError" in again.message, again.message
     assert re.search(r"Cases seed \d+\.", again.message)
 
@@ -352,7 +359,7 @@ def test_the_judge_refuses_the_step_limit_from_geomlibs_largest_eigenpair():
             continue  # judge one exercise: the step limit
         if grade_id == "explicit_step_limit":
             cell.source = (
-                "def my_explicit_step_limit(V, F):\n"
+                "def my_step_limit(V, F):\n"
                 "    from geomlib.numerics.eigen import largest_eigenpair\n"
                 "    M, C = laplacian(V, F)\n"
                 "    d = 1 / np.sqrt(M.diagonal())\n"
@@ -402,7 +409,7 @@ def course(tmp_path_factory):
     nbgrader(course, "generate_assignment", ASSIGNMENT)
     hand_in(course, "honest", NOTEBOOKS, lambda exercise, source: source)
     hand_in(course, "mistaken", ["01"], flip_the_sign_of_C)
-    recorded = record_mixed_areas(REPLAY_SEED)
+    recorded = record_uniform_laplacian(REPLAY_SEED)
     for student, names in CHEATERS.items():
         by_exercise = {CHEATS[n][1]: cheat_source(n, recorded) for n in names}
         hand_in(course, student, NOTEBOOKS, lambda exercise, source, by=by_exercise: by[exercise])

@@ -45,7 +45,8 @@ GEOMETRY_LIBRARIES = {
     "libigl": "libigl",
 }
 
-_LAZY = ("__getattr__", "__dir__")  # a package's lazy attributes (``geomlib.laplacian``): no routine yet
+# a package's lazy attributes (``geomlib.laplacian``) and a module's body run by an import: no routine yet
+_LAZY = ("__getattr__", "__dir__", "<module>")
 _GEOMLIB = str(Path(__file__).resolve().parents[2]) + os.sep
 _CHECKS = str(Path(__file__).resolve().parent) + os.sep
 

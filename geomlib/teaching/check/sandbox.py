@@ -246,6 +246,8 @@ def serve(ns, reply):
             os._exit(0)
         args = [decode(a) for a in request["args"]]
         try:
+            if request["call"] not in ns:
+                raise NameError(f"the solution cells define no `{request['call']}`")
             out = ns[request["call"]](*args)
             answer = {"ok": encode(out), "args": [encode(a) for a in args]}
         except BaseException as exc:  # noqa: BLE001 - the student's function may raise anything
