@@ -36,7 +36,9 @@ from importlib.util import spec_from_loader
 from .mesh.errors import MeshError, MeshWarning  # noqa: F401  (public names, listed in __all__)
 
 __version__ = "0.1.0"
-import_module(".teaching.frontends", __name__).enable_colab_widgets()  # Colab draws the 3D views only after this
+import_module(
+    ".teaching.display.frontends", __name__
+).enable_colab_widgets()  # Colab draws the 3D views only after this
 
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
@@ -85,6 +87,7 @@ _EXPORTS = {
     # noise and evaluation
     "add_noise": "lessons.noise",
     "denoising_experiment": "lessons.noise",
+    "denoising_sweep": "lessons.noise",
     "bounding_box_diagonal": "mesh.geometry",
     "vertex_rms": "lessons.metrics",
     "hausdorff_distance": "lessons.metrics",
@@ -98,7 +101,7 @@ _EXPORTS = {
     "denoising_metrics": "lessons.metrics",
     "MeshComparison": "lessons.metrics",
     "point_surface_distance": "lessons.metrics",
-    "smoothing_sweep": "teaching.sweep",
+    "smoothing_sweep": "teaching.experiments.sweep",
     # progress over the notebooks' loops over meshes
     "loop": "numerics.progress",
     "LARGE_MESH": "numerics.progress",
@@ -108,10 +111,10 @@ _EXPORTS = {
 _MODULES = {
     "symbolic": "lessons.symbolic",
     "check": "teaching.check",
-    "surfaces": "teaching.surfaces",
-    "viewer": "teaching.viewer",
+    "surfaces": "teaching.shapes.surfaces",
+    "viewer": "teaching.display.viewer",
     "metrics": "lessons.metrics",
-    "sweep": "teaching.sweep",
+    "sweep": "teaching.experiments.sweep",
 }
 
 

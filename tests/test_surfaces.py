@@ -1,11 +1,11 @@
-"""Tests of geomlib.teaching.surfaces: exact truth, exact placement, closed and oriented meshes."""
+"""Tests of geomlib.teaching.shapes.surfaces: exact truth, exact placement, closed and oriented meshes."""
 
 import numpy as np
 import pytest
 from partials import central_partials
 
 from geomlib import MeshError
-from geomlib.teaching import surfaces as S
+from geomlib.teaching.shapes import surfaces as S
 
 # ---------------------------------------------------------------------------
 # independent helpers (written here, not imported from the module under test)

@@ -1,4 +1,4 @@
-"""Tests of the 3D views (geomlib.teaching.viewer, .colours, .stills): colour mapping, in-place updates, normals, the still
+"""Tests of the 3D views (geomlib.teaching.display.viewer, .colours, .stills): colour mapping, in-place updates, normals, the still
 picture in the display bundle, linked cameras and input checks.
 
 The browser side (does the canvas really show the mesh, does a slider change
@@ -19,9 +19,9 @@ from PIL import Image
 
 from geomlib import MeshError
 from geomlib.mesh.geometry import vertex_normals
-from geomlib.teaching.colours import NAN_COLOR, NAN_NAME, colorize, value_range
-from geomlib.teaching.stills import render_still, view_normals
-from geomlib.teaching.viewer import MeshView, side_by_side, stills_only
+from geomlib.teaching.display.colours import NAN_COLOR, NAN_NAME, colorize, value_range
+from geomlib.teaching.display.stills import render_still, view_normals
+from geomlib.teaching.display.viewer import MeshView, side_by_side, stills_only
 
 
 @pytest.fixture(scope="module")
@@ -118,7 +118,7 @@ def test_nan_colour_stands_apart_from_the_maps_for_colour_blind_readers():
 
 
 def test_plot_cycle_is_colour_blind_safe_with_a_line_style_per_colour():
-    from geomlib.teaching.colours import PLOT_COLOURS, PLOT_LINESTYLES, plot_style
+    from geomlib.teaching.display.colours import PLOT_COLOURS, PLOT_LINESTYLES, plot_style
 
     cycle = list(plot_style()["axes.prop_cycle"])
     assert len(cycle) == len(PLOT_COLOURS) == len({str(c["linestyle"]) for c in cycle})  # no style repeats
@@ -323,8 +323,8 @@ def test_alt_text_says_mesh_quantity_range_nans_and_what_to_look_for(sphere, mes
 def test_the_still_of_a_box_of_views_carries_their_alt_text(sphere):
     from IPython.core.formatters import DisplayFormatter
 
-    from geomlib.teaching import viewer
-    from geomlib.teaching.viewer import box_alt
+    from geomlib.teaching.display import viewer
+    from geomlib.teaching.display.viewer import box_alt
 
     V, F = sphere
     a, b = MeshView(V, F, title="a", description="look at a"), MeshView(V, F, title="b")
@@ -340,7 +340,7 @@ def test_the_still_of_a_box_of_views_carries_their_alt_text(sphere):
 
 def test_still_puts_the_mesh_in_the_middle():
     # a unit square facing the camera direction fills the middle, corners stay background
-    from geomlib.teaching.stills import UP, VIEW_DIRECTION, camera_basis
+    from geomlib.teaching.display.stills import UP, VIEW_DIRECTION, camera_basis
 
     right, up, w = camera_basis(VIEW_DIRECTION, UP)
     corners = np.array([-right - up, right - up, right + up, -right + up])
@@ -363,7 +363,7 @@ def test_still_puts_the_mesh_in_the_middle():
 
 def _word_gaps(title):
     """Widths of the blank column runs between the inked columns of a still's title line."""
-    from geomlib.teaching.stills import still_with_colorbar
+    from geomlib.teaching.display.stills import still_with_colorbar
 
     image = still_with_colorbar(np.full((20, 400, 3), 255, np.uint8), None, 0.0, 1.0, "", title)
     ink = (image[:18] < 128).any(axis=(0, 2))  # the title band above the picture
@@ -498,7 +498,7 @@ def test_values_of_wrong_length(sphere):
 
 
 def test_closed_outward_takes_the_mesh_cores_volume(sphere, monkeypatch):
-    import geomlib.teaching.viewer as viewer
+    import geomlib.teaching.display.viewer as viewer
 
     V, F = sphere
     monkeypatch.setattr(viewer, "enclosed_volume", lambda V, F: -1.0)
@@ -525,7 +525,7 @@ def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
 
 
 def test_a_field_zero_up_to_rounding_draws_white(sphere):
-    from geomlib.teaching.colours import ZERO_COLOR
+    from geomlib.teaching.display.colours import ZERO_COLOR
 
     V, F = sphere
     rounding = 8e-13 * np.sin(7 * V[:, 0])  # a flat mesh's H, say: zero but for rounding

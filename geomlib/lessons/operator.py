@@ -4,7 +4,7 @@ Notebooks 05 and 06 step ``P' = P + tau M^-1 C P`` and solve ``(M - tau C) P' = 
 many times with one operator. :class:`LaplaceOperator` holds what every step,
 step limit and fixed point of one mesh needs; :func:`laplace_operator` builds it
 on first use and keeps the last ``CACHE_SIZE`` in memory under one key,
-:func:`geomlib.numerics.cache.key` of the mesh's bytes and the options (for
+:func:`geomlib.numerics.eigenbasis_store.key` of the mesh's bytes and the options (for
 uniform weights of F and the vertex count only: that operator does not depend on
 the positions, so every noisy copy of a mesh shares it). So a smoother, a step
 limit and a slider on the same mesh assemble it once.
@@ -27,14 +27,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..mesh.errors import MeshError
-from ..mesh.requirements import positive_vertex_areas
 from ..mesh.topology import boundary_vertices
 from ..mesh.validate import as_mesh, check_choice
-from ..numerics import cache
+from ..numerics import eigenbasis_store as cache
 from ..numerics.eigen import largest_eigenpair, largest_eigenvalue
 from ..numerics.factor import factor_seconds, factorise
 from ..numerics.progress import Stages
 from .laplace import check_options, laplacian
+from .requirements import positive_vertex_areas
 
 __all__ = ["LaplaceOperator", "laplace_operator", "BOUNDARY_CONDITIONS", "SOLVERS", "CACHE_SIZE"]
 

@@ -43,12 +43,12 @@ import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
 from ..mesh.geometry import bounding_box_diagonal, surface_area, volume_and_centroid
-from ..mesh.requirements import positive_vertex_areas
 from ..mesh.topology import boundary_vertices
 from ..mesh.validate import as_mesh, check_choice
 from ..numerics.factor import factorise
 from ..numerics.progress import Iterations
 from .operator import SOLVERS, LaplaceOperator, laplace_operator
+from .requirements import positive_vertex_areas
 
 __all__ = [
     "explicit_step",

@@ -22,7 +22,7 @@ meshes, block Lanczos on one sparse Cholesky factorisation otherwise).
 
 Cache (:func:`spectral_basis`, a separate entry that calls :func:`eigenbasis`
 on a miss): a basis is kept in memory (the last few meshes) and on disk
-(:mod:`geomlib.numerics.cache`), so a slider over ``k`` re-projects without
+(:mod:`geomlib.numerics.eigenbasis_store`), so a slider over ``k`` re-projects without
 solving again and a restarted kernel finds it. ``cache=False`` neither reads
 nor writes it; :func:`clear_spectral_cache` empties it;
 :func:`spectral_cache_dir` says where it is.
@@ -36,11 +36,11 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.requirements import positive_vertex_areas
 from ..mesh.validate import as_mesh
-from ..numerics import cache as basis_cache
+from ..numerics import eigenbasis_store as basis_cache
 from ..numerics.eigen import one_blas_thread, smallest_eigenpairs
 from .laplace import laplacian, uniform_laplacian, vertex_areas
+from .requirements import positive_vertex_areas
 
 __all__ = [
     "eigenbasis",
@@ -326,7 +326,7 @@ def spectral_basis(
     """:func:`eigenbasis` behind a cache, as a :class:`SpectralBasis`.
 
     The basis of a mesh and its options is kept in memory (the last few) and
-    on disk (:mod:`geomlib.numerics.cache`, under :func:`spectral_cache_dir`
+    on disk (:mod:`geomlib.numerics.eigenbasis_store`, under :func:`spectral_cache_dir`
     or ``cache_dir``), so asking again, with any k up to the stored one, or
     after a kernel restart, does not solve. ``cache=False`` neither reads nor
     writes it. ``basis.reconstruct(X, j)`` then projects per-vertex values X
@@ -373,7 +373,7 @@ def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cac
 
 
 def spectral_cache_dir(cache_dir=None):
-    """The folder holding cached eigenbases (it need not exist yet); see :func:`geomlib.numerics.cache.folder`."""
+    """The folder holding cached eigenbases (it need not exist yet); see :func:`geomlib.numerics.eigenbasis_store.folder`."""
     return basis_cache.folder(cache_dir)
 
 

@@ -12,13 +12,21 @@ from importlib import import_module
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
     **dict.fromkeys(["reveal", "use"], "check"),
-    **dict.fromkeys(["live", "mesh_warnings"], "controls"),
+    **dict.fromkeys(["live", "mesh_warnings"], "display.controls"),
     **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
-    **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "steps"),
+    **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "experiments.steps"),
     **dict.fromkeys(
-        ["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "denoising_comparison", "plot_comparison", "smoothing_sweep"], "sweep"
+        [
+            "EXPLICIT_FRACTIONS",
+            "IMPLICIT_STEPS",
+            "denoising_comparison",
+            "plot_comparison",
+            "plot_sweep",
+            "smoothing_sweep",
+        ],
+        "experiments.sweep",
     ),
-    **dict.fromkeys(["MeshView", "side_by_side"], "viewer"),
+    **dict.fromkeys(["MeshView", "side_by_side"], "display.viewer"),
 }
 
 __all__ = sorted(_EXPORTS)

@@ -338,8 +338,8 @@ def _near(value, target):
         "lessons.metrics.vertex_rms",
         "lessons.metrics.denoising_metrics",
         "lessons.metrics.MeshComparison",
-        "teaching.sweep.smoothing_sweep",
-        "teaching.sweep.denoising_comparison",
+        "teaching.experiments.sweep.smoothing_sweep",
+        "teaching.experiments.sweep.denoising_comparison",
     ),
     allow=("lessons.smoothing.implicit_smoothing",),
 )

@@ -10,7 +10,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ...lessons.laplace import laplacian
-from .. import surfaces
+from ..shapes import surfaces
 from .result import Mistake, call, close, exercise
 
 __all__ = ["explicit_step", "explicit_step_limit", "smoothing_loop"]

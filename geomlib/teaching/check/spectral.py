@@ -28,7 +28,7 @@ import scipy.linalg
 
 from ...lessons.laplace import laplacian, vertex_areas
 from ...mesh.topology import boundary_vertices
-from ..surfaces import ellipsoid, saddle, sphere
+from ..shapes.surfaces import ellipsoid, saddle, sphere
 from .result import Mistake, call, close, exercise
 
 __all__ = ["eigenpairs", "spectral_reconstruction"]

@@ -13,7 +13,7 @@ import numpy as np
 from ...lessons.curvature import angle_deficit, boundary_mask
 from ...lessons.curvature import gaussian_curvature as geomlib_gaussian_curvature
 from ...lessons.laplace import barycentric_areas, laplacian
-from ..surfaces import sphere
+from ..shapes.surfaces import sphere
 from .areas import area_mistake_over
 from .result import Mistake, call, close, exercise, matrix_pair, vector
 

@@ -12,7 +12,7 @@ is exactly zero; NaN values are drawn bright violet (``colours.NAN_COLOR``, far
 from every colour of the maps for colour-blind readers too) and counted under the
 colour bar, which names the colour.
 
-    from geomlib.teaching.viewer import MeshView, side_by_side
+    from geomlib.teaching.display.viewer import MeshView, side_by_side
     view = MeshView(V, F, values=H, symmetric=True, label="H (1/length)")
     slider = ipywidgets.FloatSlider(0.0, min=0.0, max=1.0, description="t")
     slider.observe(lambda change: view.update(V=V + change["new"] * D), "value")
@@ -35,7 +35,7 @@ if there is none, the first slider displayed by the same cell as a view
 cell change. So a notebook needs at least one slider next to a view in one of
 these two ways, and that slider must change the picture whether it is moved to
 its maximum (or to its minimum when it starts there). Sliders elsewhere are
-not moved by the test (``geomlib.teaching.controls.live`` puts its controls and views in one
+not moved by the test (``geomlib.teaching.display.controls.live`` puts its controls and views in one
 box). Views shown with ``side_by_side`` are also checked for
 linked cameras (an orbit drag in the first view must turn the second).
 
@@ -117,10 +117,11 @@ import weakref
 
 import numpy as np
 
-from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import enclosed_volume
-from ..mesh.topology import Topology, edges
-from ..mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
+from ...mesh.errors import MeshError, format_indices
+from ...mesh.geometry import enclosed_volume
+from ...mesh.topology import Topology, edges
+from ...mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
+from ..notebook import graded
 from .colours import (
     NAN_COLOR,
     NAN_NAME,
@@ -135,7 +136,6 @@ from .colours import (
     value_range,
     zero_html,
 )
-from .notebook import graded
 from .stills import (
     FOV,
     UP,

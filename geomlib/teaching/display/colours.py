@@ -13,7 +13,7 @@ import html
 
 import numpy as np
 
-from ..mesh.errors import MeshError
+from ...mesh.errors import MeshError
 
 __all__ = [
     "NAN_COLOR",

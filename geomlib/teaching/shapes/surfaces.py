@@ -48,9 +48,9 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import face_cross, zero_area_faces
-from ..mesh.validate import check_choice
+from ...mesh.errors import MeshError, format_indices
+from ...mesh.geometry import face_cross, zero_area_faces
+from ...mesh.validate import check_choice
 
 __all__ = [
     "AnalyticMesh",
@@ -331,7 +331,7 @@ def _symbolic_surface(kind, params):
     derived without simplifying (the same values, a fraction of the time)."""
     import sympy as sp
 
-    from ..lessons import symbolic
+    from ...lessons import symbolic
 
     if kind == "ellipsoid":
         return symbolic.ellipsoid(*params, simplify=False)

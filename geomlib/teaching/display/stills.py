@@ -13,7 +13,7 @@ import io
 
 import numpy as np
 
-from ..mesh.geometry import bounding_box_diagonal, vertex_normals
+from ...mesh.geometry import bounding_box_diagonal, vertex_normals
 from .colours import format_value
 
 __all__ = [
