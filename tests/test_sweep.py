@@ -11,7 +11,8 @@ import pytest
 import trimesh
 
 import geomlib
-from geomlib.teaching.experiments.sweep import COMPARISON_GRIDS, denoising_comparison, plot_comparison
+from geomlib.teaching.experiments.sweep import COMPARISON_GRIDS, denoising_comparison
+from geomlib.teaching.figures.denoising_plots import plot_comparison
 
 
 def icosphere(subdivisions):

@@ -47,9 +47,12 @@ __all__ = [
     "laplacian",
     "uniform_laplacian",
     "cotangent_matrix",
+    "intrinsic_cotangent_matrix",
+    "edge_lengths",
     "vertex_areas",
     "barycentric_areas",
     "mixed_areas",
+    "voronoi_pieces",
     "face_geometry",
     "uniform_adjacency",
     "WEIGHTS",
@@ -156,7 +159,8 @@ def uniform_laplacian(V, F):
     """(M, C) of the uniform (graph) Laplacian: C_ij = 1 on every edge, C_ii = -valence, M = diag(valence).
 
     C is symmetric, NSD, rows sum to zero; ``M^-1 C x`` is the mean of the
-    neighbours minus ``x_i`` (the "umbrella" operator, Taubin 1995). No metric:
+    neighbours minus ``x_i`` (the weights of Taubin 1995; the name "umbrella" operator is Kobbelt et
+    al. 1998's). No metric:
     zero-area faces count like any other.
 
     Returns
@@ -177,18 +181,41 @@ def uniform_laplacian(V, F):
     return sp.diags(valence), C
 
 
-def cotangent_matrix(V, F, faces=None):
-    """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
+def edge_lengths(V, F):
+    """(m, 3) float64: ``l[f, i]`` is the length of the edge of face f opposite its corner i (length).
 
-    Triangle ``(v0, v1, v2)`` adds ``1/2 cot theta_i`` to the edge ``(j, k)``
-    opposite its corner i. A boundary edge has one triangle, so one angle:
-    ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
-    ``faces``: :func:`face_geometry` of (V, F) when the caller has it already.
-    Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
+    Everything the cotangent Laplacian needs of the geometry (:func:`intrinsic_cotangent_matrix`).
     """
     V, F = as_mesh(V, F)
-    n = len(V)
-    _, _, cot, _ = faces or measured_faces(V, F)
+    return np.sqrt(face_geometry(V, F)[0])
+
+
+def intrinsic_cotangent_matrix(l, F, n=None, dblA=None):
+    """C (n, n) CSR from the edge lengths alone: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``.
+
+    ``l`` (m, 3): ``l[f, i]`` the length of the edge opposite corner i of face f (:func:`edge_lengths`);
+    ``n``: the vertex count (default ``F.max() + 1``). Heron's formula gives the area A of each face,
+    the law of cosines its corner cotangents ``cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)``; corner
+    i adds ``1/2 cot theta_i`` to the edge (j, k) opposite it, so a boundary edge, with one triangle,
+    gets ``1/2 cot alpha_ij``. C is symmetric, negative semidefinite, rows sum to zero. Zero-area
+    triangles add nothing (MeshWarning). Jacobson's intrinsic ``cotmatrix``; Pinkall and Polthier 1993.
+
+    ``dblA`` (m,): twice the face areas, when the caller has them from the positions. A needle's
+    area is exact from a cross product, while its rounded lengths can make Heron's vanish
+    (sides 1, 1 and 2 for a height of 1e-9): :func:`cotangent_matrix` passes it.
+    """
+    l, F = np.asarray(l, dtype=np.float64), np.asarray(F)
+    n = int(F.max()) + 1 if n is None else n
+    if dblA is None:
+        a, b, c = np.sort(l, axis=1)[:, ::-1].T  # a >= b >= c: Heron in Kahan's order, stable for thin faces
+        A = 0.25 * np.sqrt(np.maximum((a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c)), 0.0))
+    else:
+        A = 0.5 * np.asarray(dblA, dtype=np.float64)
+    l2 = l**2
+    degenerate = is_zero_area(2 * A, l2.max(axis=1))
+    warn_zero_area(degenerate)
+    cot = (l2[:, NEXT] + l2[:, PREV] - l2) / (4 * np.where(degenerate, 1.0, A)[:, None])  # law of cosines / sine
+    cot[degenerate] = 0.0
     index = np.int32 if n < 2**31 - 1 else np.int64
     j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
     w = 0.5 * cot.T.ravel()  # gets 1/2 cot theta_i
@@ -198,16 +225,43 @@ def cotangent_matrix(V, F, faces=None):
     return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
 
 
+def cotangent_matrix(V, F):
+    """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
+
+    :func:`intrinsic_cotangent_matrix` of the mesh's edge lengths, with the face areas from
+    cross products: the cotangents depend on the lengths alone. A boundary edge has one triangle, so one angle:
+    ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
+    Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
+    """
+    V, F = as_mesh(V, F)
+    l2, dblA, _, _ = face_geometry(V, F)
+    return intrinsic_cotangent_matrix(np.sqrt(l2), F, len(V), dblA)
+
+
 def barycentric_areas(V, F, faces=None):
     """(n,) vertex areas A_i in length^2: a third of the area of every incident triangle.
 
     Zero-area triangles add 0 (MeshWarning), so a vertex in no other triangle
-    has area 0. Sums to the surface area. ``faces`` as in :func:`cotangent_matrix`.
+    has area 0. Sums to the surface area. ``faces``: :func:`face_geometry` of (V, F)
+    when the caller has it already (then no warning: the caller gives it).
     """
     V, F = as_mesh(V, F)
     dblA, degenerate = (faces[1], faces[3]) if faces else measured_areas(V, F)
     third = np.where(degenerate, 0.0, dblA / 6.0)
     return np.bincount(F.ravel(), np.repeat(third, 3), minlength=len(V))  # to each of the 3 corners
+
+
+def voronoi_pieces(V, F, faces=None):
+    """(m, 3) Voronoi piece of each corner, ``1/8 (|e_j|^2 cot theta_j + |e_k|^2 cot theta_k)``, without the obtuse rule.
+
+    The circumcentric region of corner i inside its triangle, a signed area in length^2: it
+    leaves the triangle when the triangle is obtuse, and is negative at corner i exactly when
+    the other two angles differ by more than 90 degrees (notebook 03, section 2).
+    ``faces`` as in :func:`cotangent_matrix`.
+    """
+    l2, _, cot, _ = faces or face_geometry(V, F)
+    lc = l2 * cot
+    return (lc[:, NEXT] + lc[:, PREV]) / 8.0
 
 
 def mixed_areas(V, F, faces=None):
@@ -221,13 +275,12 @@ def mixed_areas(V, F, faces=None):
     * obtuse at another corner: ``A / 4``.
 
     Sums to the surface area. Zero-area triangles add 0 (MeshWarning).
-    ``faces`` as in :func:`cotangent_matrix`.
+    ``faces`` as in :func:`barycentric_areas`.
     """
     V, F = as_mesh(V, F)
     l2, dblA, cot, degenerate = faces or measured_faces(V, F)
     A = 0.5 * dblA[:, None]
-    lc = l2 * cot
-    voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
+    voronoi = voronoi_pieces(V, F, (l2, dblA, cot, degenerate))
     obtuse = cot < 0  # cot theta < 0 <=> theta > pi/2
     obtuse_triangle = obtuse.any(axis=1, keepdims=True)
     per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
@@ -240,7 +293,7 @@ def vertex_areas(V, F, area="barycentric", faces=None):
 
     ``area="barycentric"``: :func:`barycentric_areas`; ``"mixed"``:
     :func:`mixed_areas` (Meyer et al. 2003). Both sum to the surface area.
-    ``faces`` as in :func:`cotangent_matrix`.
+    ``faces`` as in :func:`barycentric_areas`.
     """
     check_options(area=area)
     return (barycentric_areas if area == "barycentric" else mixed_areas)(V, F, faces)
@@ -284,8 +337,9 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     V, F = as_mesh(V, F)
     if weights == "uniform":
         return uniform_laplacian(V, F)
-    faces = measured_faces(V, F)  # once for both matrices; names the zero-area faces, if any
-    return sp.diags(vertex_areas(V, F, area, faces)), cotangent_matrix(V, F, faces)
+    faces = face_geometry(V, F)  # once for both matrices
+    C = intrinsic_cotangent_matrix(np.sqrt(faces[0]), F, len(V), faces[1])  # names the zero-area faces, if any
+    return sp.diags(vertex_areas(V, F, area, faces)), C
 
 
 def uniform_adjacency(n, F):

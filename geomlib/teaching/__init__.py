@@ -1,6 +1,9 @@
 """Teaching aids: 3D views and stills, exercise checks, notebook helpers, experiment drivers.
 
-May import every other layer; no other layer imports it.
+May import the mesh core, numerics and lessons; only the course tools import it. Its parts:
+``shapes/`` (the exact surfaces tests and checks rely on), ``experiments/`` (the step unit,
+the sweeps of notebook 07), ``display/`` (views, stills, controls), ``figures/`` (the
+notebooks' matplotlib figures), ``check/`` (exercise checks), ``notebook`` (claims, notes).
 
 The names a lesson notebook uses are importable from here, so that a notebook's
 teaching aids come in one line (``from geomlib.teaching import claim, live, MeshView``).
@@ -20,13 +23,12 @@ _EXPORTS = {
             "EXPLICIT_FRACTIONS",
             "IMPLICIT_STEPS",
             "denoising_comparison",
-            "plot_comparison",
-            "plot_sweep",
             "smoothing_sweep",
         ],
         "experiments.sweep",
     ),
-    **dict.fromkeys(["MeshView", "side_by_side"], "display.viewer"),
+    **dict.fromkeys(["MeshView", "setup_display", "side_by_side"], "display.viewer"),
+    **dict.fromkeys(["plot_comparison", "plot_sweep"], "figures.denoising_plots"),
 }
 
 __all__ = sorted(_EXPORTS)

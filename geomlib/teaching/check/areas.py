@@ -24,9 +24,9 @@ of "twice" names both.
 
 import numpy as np
 
-from ...lessons.laplace import barycentric_areas, face_geometry, mixed_areas
+from ...lessons.laplace import barycentric_areas, face_geometry, mixed_areas, voronoi_pieces
 
-__all__ = ["area_mistake", "area_mistake_over", "typical_areas", "voronoi_pieces", "corner_sums", "ASKED"]
+__all__ = ["area_mistake", "area_mistake_over", "typical_areas", "corner_sums", "ASKED"]
 
 ASKED = ("barycentric", "mixed")
 
@@ -39,18 +39,6 @@ _OBTUSE_TRUTH = (
     "in an obtuse triangle the circumcentre lies outside, so the Voronoi pieces are no longer regions inside "
     "the triangle (a piece is even negative where the other two angles differ by more than 90 degrees)"
 )
-
-
-def voronoi_pieces(V, F):
-    """(m, 3) Voronoi piece of each corner, 1/8 (l_j^2 cot_j + l_k^2 cot_k), without the obtuse rule.
-
-    The circumcentric region of the corner inside its triangle, a signed area: it leaves the
-    triangle when the triangle is obtuse, and is negative at corner i exactly when the other two
-    angles differ by more than 90 degrees (notebook 03, section 2).
-    """
-    l2, _, cot, _ = face_geometry(V, F)
-    lc = l2 * cot
-    return np.stack([lc[:, 1] + lc[:, 2], lc[:, 2] + lc[:, 0], lc[:, 0] + lc[:, 1]], axis=1) / 8
 
 
 def corner_sums(n, F, pieces):

@@ -103,8 +103,9 @@ repository previews still show the mesh. (``jupyter nbconvert --to html``
 shows the still unless the notebook was saved with its widget state; with the
 state it embeds the live widget, which needs the widget scripts from a CDN.)
 A view shown inside an ipywidgets box (``VBox([slider, view.widget])``) is
-drawn too: importing this module in IPython gives every box holding views a
-still picture of them (``box_still``), side by side.
+drawn too: after :func:`setup_display` (each notebook's set-up cell calls it, and
+so does the first view) every box holding views has a still picture of them
+(``box_still``), side by side.
 
 While nbgrader runs a notebook (``autograde``, ``validate``) a view gives its
 still picture and summary only, without the widget (``stills_only``), and other
@@ -136,6 +137,7 @@ from .colours import (
     value_range,
     zero_html,
 )
+from .frontends import enable_colab_widgets
 from .stills import (
     FOV,
     UP,
@@ -150,7 +152,7 @@ from .stills import (
     view_normals,
 )
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only"]
+__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only", "setup_display"]
 
 #: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
 #: of the largest one is drawn enlarged to the largest one's size
@@ -285,7 +287,9 @@ class MeshView:
     width, height : int
         Canvas size in pixels.
     title : str or None
-        Heading shown above the canvas.
+        Heading shown above the canvas: what the view shows, a noun ("signed mean
+        curvature", "the mesh coloured by height"); its text alternative begins
+        "3D view of" the title (without one: "3D view of a mesh of n vertices").
     label : str or None
         Name and unit of the values, shown under the colour bar, e.g. "H (1/length)".
     up : {"z", "y", "x"}
@@ -340,6 +344,7 @@ class MeshView:
         import ipywidgets as widgets
         import pythreejs as three
 
+        setup_display()
         V = as_vertices(V)
         self._n = V.shape[0]
         # a face that repeats a vertex is drawn as nothing, not refused: a view shows any mesh
@@ -547,8 +552,8 @@ class MeshView:
 
         Shown under the canvas, given to the still as its alt and to the canvas on the website.
         """
-        what = f"3D view of {self.title}" if self.title else "3D view"
-        text = f"{what}: a mesh of {self._n} vertices and {self._F.shape[0]} faces"
+        mesh = f"a mesh of {self._n} vertices and {self._F.shape[0]} faces"
+        text = f"3D view of {self.title}: {mesh}" if self.title else f"3D view of {mesh}"
         if self._scale != 1.0:
             text += f", drawn {self._scale:.3g} times larger"
         name = self.label or "the values"
@@ -636,6 +641,7 @@ class MeshView:
             distance=(distance or self._distance) / self._scale,
             centre=self._centre,
             cull_back=self.closed,
+            edges=None if self.wireframe is None else edges(self._triangles),
         )
         lo, hi = self.range
         lut = self._lut if self._values is not None and not self.is_zero else None
@@ -764,12 +770,20 @@ def _widget_stills_only(widget):
     )
 
 
-def _give_boxes_stills():
-    """In IPython, display every ipywidgets box with the still of its views as image/png
-    (with ``stills_only``, every widget without its widget view: a box as the still of
-    its views, any other as its text), and draw plots in :func:`.colours.plot_style`."""
+def setup_display():
+    """Set up this session's display for the workbook; each notebook's set-up cell calls it.
+
+    In Colab, enables its custom widget manager (:func:`.frontends.enable_colab_widgets`),
+    without which the 3D views are not drawn. In IPython, displays every ipywidgets box
+    with the still of its views as image/png (with ``stills_only``, every widget without
+    its widget view: a box as the still of its views, any other as its text), and draws
+    plots in :func:`.colours.plot_style`. Calling it again changes nothing; a
+    :class:`MeshView` calls it when it is made, so a view is drawn in a reader's own
+    notebook too.
+    """
     from IPython import get_ipython
 
+    enable_colab_widgets()
     shell = get_ipython()
     if shell is not None:
         import ipywidgets
@@ -779,9 +793,6 @@ def _give_boxes_stills():
             shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_stills_only)
         # a notebook's own plots: colour-blind-safe colours, each with its own line style
         use_plot_style()
-
-
-_give_boxes_stills()
 
 
 def side_by_side(*views, link_cameras=True):

@@ -15,11 +15,10 @@ areas are the mixed areas.
 
 import numpy as np
 
-from ...lessons.laplace import barycentric_areas, face_geometry
+from ...lessons.laplace import barycentric_areas, face_geometry, voronoi_pieces
 from ...mesh.errors import MeshError
 from ...mesh.topology import boundary_vertices, one_ring
 from ...mesh.validate import as_mesh
-from ..check.areas import voronoi_pieces
 from ..shapes import surfaces
 
 __all__ = [
