@@ -17,7 +17,7 @@ from ...lessons.laplace import laplacian
 from .catalogue import Case, Wrong, agree, judge
 from .explicit import closed_ellipsoid, eigenvalues, explicit_loop, interior_blocks, loop_answer, loop_grid
 from .meshes import placed
-from .result import call, case_rng, exercise
+from .result import case_rng, exercise
 
 __all__ = ["implicit_loop"]
 
@@ -28,8 +28,9 @@ _REREAD = "section 1 · Backward Euler, derived"
 AGREE = 1e-3
 
 
-def implicit_loop_of(c, tau=None, N=None, held=True, rebuild=False, sign=1.0, mass=True, rhs_mass=True,
-                     coupling=1.0, weights="cotan"):
+def implicit_loop_of(
+    c, tau=None, N=None, held=True, rebuild=False, sign=1.0, mass=True, rhs_mass=True, coupling=1.0, weights="cotan"
+):
     """N implicit steps from the case's V with the named changes: the right loop, or one of its mistakes."""
     tau, N = c.tau if tau is None else tau, c.N if N is None else N
     P = c.V.copy()
@@ -45,37 +46,81 @@ def implicit_loop_of(c, tau=None, N=None, held=True, rebuild=False, sign=1.0, ma
 
 
 IMPLICIT_MISTAKES = [
-    Wrong("no step was taken: the input positions come back", "return the positions the loop computed",
-          build=lambda c: c.V),
-    Wrong("the loop takes one step too few", "range(N) runs exactly N steps",
-          build=lambda c: implicit_loop_of(c, N=c.N - 1)),
-    Wrong("the loop takes one step too many", "range(N) runs exactly N steps",
-          build=lambda c: implicit_loop_of(c, N=c.N + 1)),
-    Wrong("the boundary moves: the whole system (M - tau C) P' = M P is solved", "solve the interior block only",
-          build=lambda c: implicit_loop_of(c, held=False)),
-    Wrong("M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V",
-          "call laplacian(V, F) once, before the loop", build=lambda c: implicit_loop_of(c, rebuild=True)),
-    Wrong("the sign of tau C is flipped: (M_II + tau C_II), indefinite for large tau", "M_II - tau C_II",
-          build=lambda c: implicit_loop_of(c, sign=-1.0)),
-    Wrong("the loop takes half a step, tau / 2", "the step is tau itself",
-          build=lambda c: implicit_loop_of(c, tau=c.tau / 2)),
-    Wrong("M is forgotten in the matrix: (I - tau C_II)", "the matrix is M_II - tau C_II",
-          build=lambda c: implicit_loop_of(c, mass=False)),
-    Wrong("M is forgotten in the matrix and on the right: (I - tau C_II) P_I' = P_I + ...",
-          "multiply (P' - P) / tau = M^-1 C P' by tau M: the matrix M_II - tau C_II, the right side M_II P_I + ...",
-          build=lambda c: implicit_loop_of(c, mass=False, rhs_mass=False)),
-    Wrong("the right-hand side holds P_I where M_II P_I belongs", "the right side is M_II P_I + tau C_IB P_B",
-          build=lambda c: implicit_loop_of(c, rhs_mass=False)),
-    Wrong("the held boundary's term tau C_IB P_B is missing from the right-hand side",
-          "moving the known P_B to the right gives + tau C_IB P_B", build=lambda c: implicit_loop_of(c, coupling=0.0)),
-    Wrong("the held boundary's term has the wrong sign: - tau C_IB P_B", "it is + tau C_IB P_B",
-          build=lambda c: implicit_loop_of(c, coupling=-1.0)),
-    Wrong("these are explicit steps P_I + tau M_II^-1 (C P)_I, not implicit ones",
-          "evaluate the Laplacian at the new positions: solve the block system", build=explicit_loop),
-    Wrong("the loop smooths with the uniform operator; the task asks for the cotangent one",
-          "laplacian(V, F) with its default weights", build=lambda c: implicit_loop_of(c, weights="uniform")),
-    Wrong("the boundary vertices moved on {label}", "hold them: solve for the interior rows only",
-          when=lambda a, right, c: not agree(a[c.B], c.V[c.B])),
+    Wrong(
+        "no step was taken: the input positions come back",
+        "return the positions the loop computed",
+        build=lambda c: c.V,
+    ),
+    Wrong(
+        "the loop takes one step too few",
+        "range(N) runs exactly N steps",
+        build=lambda c: implicit_loop_of(c, N=c.N - 1),
+    ),
+    Wrong(
+        "the loop takes one step too many",
+        "range(N) runs exactly N steps",
+        build=lambda c: implicit_loop_of(c, N=c.N + 1),
+    ),
+    Wrong(
+        "the boundary moves: the whole system (M - tau C) P' = M P is solved",
+        "solve the interior block only",
+        build=lambda c: implicit_loop_of(c, held=False),
+    ),
+    Wrong(
+        "M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V",
+        "call laplacian(V, F) once, before the loop",
+        build=lambda c: implicit_loop_of(c, rebuild=True),
+    ),
+    Wrong(
+        "the sign of tau C is flipped: (M_II + tau C_II), indefinite for large tau",
+        "M_II - tau C_II",
+        build=lambda c: implicit_loop_of(c, sign=-1.0),
+    ),
+    Wrong(
+        "the loop takes half a step, tau / 2",
+        "the step is tau itself",
+        build=lambda c: implicit_loop_of(c, tau=c.tau / 2),
+    ),
+    Wrong(
+        "M is forgotten in the matrix: (I - tau C_II)",
+        "the matrix is M_II - tau C_II",
+        build=lambda c: implicit_loop_of(c, mass=False),
+    ),
+    Wrong(
+        "M is forgotten in the matrix and on the right: (I - tau C_II) P_I' = P_I + ...",
+        "multiply (P' - P) / tau = M^-1 C P' by tau M: the matrix M_II - tau C_II, the right side M_II P_I + ...",
+        build=lambda c: implicit_loop_of(c, mass=False, rhs_mass=False),
+    ),
+    Wrong(
+        "the right-hand side holds P_I where M_II P_I belongs",
+        "the right side is M_II P_I + tau C_IB P_B",
+        build=lambda c: implicit_loop_of(c, rhs_mass=False),
+    ),
+    Wrong(
+        "the held boundary's term tau C_IB P_B is missing from the right-hand side",
+        "moving the known P_B to the right gives + tau C_IB P_B",
+        build=lambda c: implicit_loop_of(c, coupling=0.0),
+    ),
+    Wrong(
+        "the held boundary's term has the wrong sign: - tau C_IB P_B",
+        "it is + tau C_IB P_B",
+        build=lambda c: implicit_loop_of(c, coupling=-1.0),
+    ),
+    Wrong(
+        "these are explicit steps P_I + tau M_II^-1 (C P)_I, not implicit ones",
+        "evaluate the Laplacian at the new positions: solve the block system",
+        build=explicit_loop,
+    ),
+    Wrong(
+        "the loop smooths with the uniform operator; the task asks for the cotangent one",
+        "laplacian(V, F) with its default weights",
+        build=lambda c: implicit_loop_of(c, weights="uniform"),
+    ),
+    Wrong(
+        "the boundary vertices moved on {label}",
+        "hold them: solve for the interior rows only",
+        when=lambda a, right, c: not agree(a[c.B], c.V[c.B]),
+    ),
     Wrong("the positions after N steps differ from the block system's on {label}", typical=False),
 ]
 
@@ -90,19 +135,26 @@ IMPLICIT_MISTAKES = [
         "lessons.operator.LaplaceOperator",
         "lessons.operator.laplace_operator",
     ),
-    own=("lessons.smoothing.implicit_smoothing", "lessons.smoothing.implicit_step",
-         "lessons.operator.LaplaceOperator.step_solver"),
+    own=("lessons.smoothing.implicit_smoothing", "lessons.smoothing.implicit_step", "lessons.operator.LaplaceOperator"),
 )
 def implicit_loop(fn):
     """Check ``fn(V, F, tau, N) -> P``: N implicit steps by the interior block system, M and C of V built once."""
     rng, cases = case_rng(), []
     grid = placed(*loop_grid(), rng)
-    for label, (V, F), N in (("an open jittered grid (20 boundary vertices)", grid, 3), ("the same grid", grid, 1),
-                             ("a closed 42-vertex ellipsoid", placed(*closed_ellipsoid(), rng), 2)):
+    for label, (V, F), N in (
+        ("an open jittered grid (20 boundary vertices)", grid, 3),
+        ("the same grid", grid, 1),
+        ("a closed 42-vertex ellipsoid", placed(*closed_ellipsoid(), rng), 2),
+    ):
         m_I, C_I, I, B = interior_blocks(V, F)
         tau = 3 * 2 / eigenvalues(m_I, C_I[:, I])[-1]
         cases.append(Case(label, V=V, F=F, tau=tau, N=N).but(I=I, B=B))
     answers = [loop_answer(fn, c) for c in cases]
-    judge(IMPLICIT_MISTAKES, cases, answers, right=implicit_loop_of,
-          same=lambda a, b, c: agree(a - c.V, b - c.V, c, rtol=AGREE))
+    judge(
+        IMPLICIT_MISTAKES,
+        cases,
+        answers,
+        right=implicit_loop_of,
+        same=lambda a, b, c: agree(a - c.V, b - c.V, c, rtol=AGREE),
+    )
     return [c.label for c in cases]

@@ -8,7 +8,7 @@ learner's function so that such a call, however the routine was imported, fails 
 check with no points and names the routine.
 
 A call counts as the learner's when nothing but scipy's batching wrapper stands between
-it and code outside numpy and scipy: scipy's own solvers may call these routines inside
+it and code outside numpy, scipy and geomlib: their own solvers may call these routines inside
 (``lobpcg`` calls ``eigh`` with a second matrix), and that is not the learner's doing.
 """
 
@@ -51,11 +51,11 @@ DENSE = _watch(
     }
 )
 
-_LIBRARIES = ("numpy", "scipy")
+_LIBRARIES = ("numpy", "scipy", "geomlib")  # geomlib's own calls are judged by its ground rules (result.call)
 
 
 def _learners(frame):
-    """Whether the call in ``frame`` comes from outside numpy and scipy (past scipy's batching wrapper)."""
+    """Whether the call in ``frame`` comes from outside numpy, scipy and geomlib (past scipy's batching wrapper)."""
     caller = frame.f_back
     while caller is not None and caller.f_code.co_filename.endswith(("_lib/_util.py", "_lib\\_util.py")):
         caller = caller.f_back
@@ -83,8 +83,11 @@ def refusing(fn, watch, why):
         finally:
             sys.setprofile(previous)
         if hits:
-            raise Mistake(f"the function calls {hits[0]}, which the ground rules exclude, so it earns no points", why,
-                          typical=False)
+            raise Mistake(
+                f"the function calls {hits[0]}, which the ground rules exclude, so it earns no points",
+                why,
+                typical=False,
+            )
         return out
 
     wrapped.__name__ = getattr(fn, "__name__", "function")

@@ -27,7 +27,7 @@ from one dense basis and named when met.
 import numpy as np
 import scipy.linalg
 
-from ...lessons.laplace import laplacian, vertex_areas
+from ...lessons.laplace import laplacian
 from ...mesh.topology import boundary_vertices
 from ..shapes.surfaces import ellipsoid, saddle, sphere
 from .catalogue import Case, Wrong, agree, judge, positions
@@ -72,43 +72,85 @@ def _gram(E, c):
 
 
 LAM_MISTAKES = [
-    Wrong("the sign of C is flipped: the eigenvalues are <= 0, those of M^-1/2 C M^-1/2", "Q = -M^-1/2 C M^-1/2",
-          build=lambda c: -c.every[: c.k]),
-    Wrong("the sign of C is flipped, and the first k of M^-1/2 C M^-1/2 are its most negative",
-          "Q = -M^-1/2 C M^-1/2, whose smallest eigenvalues are the ones near 0", build=lambda c: -c.every[::-1][: c.k]),
-    Wrong("the eigenvalues are the k largest, not the k smallest", "take the first k of the ascending eigenvalues, or "
-          "eigsh in shift-invert mode with sigma just below 0", build=lambda c: c.every[-c.k :]),
-    Wrong("the null mode is lost: lam_0 = 0 (the constant eigenvector) is missing, the values start at lam_1",
-          "keep the eigenpair of lam = 0: the reconstruction needs it", build=lambda c: c.every[1 : c.k + 1]),
-    Wrong("M is left out: these are the eigenvalues of -C itself", "Q = -M^-1/2 C M^-1/2",
-          build=lambda c: c.plain[: c.k]),
-    Wrong("M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2", "Q = -M^-1/2 C M^-1/2: the square roots of the areas",
-          build=lambda c: c.inverse[: c.k]),
-    Wrong("the eigenvalues are not sorted (np.linalg.eig and eigsh return them in no particular order), so the first "
-          "k taken are not the k smallest", "sort them, and the columns with them: order = np.argsort(lam)",
-          when=lambda lam, right, c: np.all(np.abs(lam[:, None] - c.every[None, :]).min(axis=1) <= 1e-6 * c.every[-1])
-          and not agree(lam, right)),
-    Wrong("the eigenvalues differ from the k smallest of C e = -lam M e on {label}", "Q = -M^-1/2 C M^-1/2 and a "
-          "symmetric solver", when=lambda lam, right, c: True, typical=False),
+    Wrong(
+        "the sign of C is flipped: the eigenvalues are <= 0, those of M^-1/2 C M^-1/2",
+        "Q = -M^-1/2 C M^-1/2",
+        when=lambda lam, right, c: agree(np.sort(lam), np.sort(-right)),
+    ),
+    Wrong(
+        "the sign of C is flipped, and the first k of M^-1/2 C M^-1/2 are its most negative",
+        "Q = -M^-1/2 C M^-1/2, whose smallest eigenvalues are the ones near 0",
+        build=lambda c: -c.every[::-1][: c.k],
+    ),
+    Wrong(
+        "the eigenvalues are the k largest, not the k smallest",
+        "take the first k of the ascending eigenvalues, or eigsh in shift-invert mode with sigma just below 0",
+        build=lambda c: c.every[-c.k :],
+    ),
+    Wrong(
+        "the null mode is lost: lam_0 = 0 (the constant eigenvector) is missing, the values start at lam_1",
+        "keep the eigenpair of lam = 0: the reconstruction needs it",
+        build=lambda c: c.every[1 : c.k + 1],
+    ),
+    Wrong(
+        "M is left out: these are the eigenvalues of -C itself", "Q = -M^-1/2 C M^-1/2", build=lambda c: c.plain[: c.k]
+    ),
+    Wrong(
+        "M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2",
+        "Q = -M^-1/2 C M^-1/2: the square roots of the areas",
+        build=lambda c: c.inverse[: c.k],
+    ),
+    Wrong(
+        "the eigenvalues are not sorted (np.linalg.eig and eigsh return them in no particular order), so the first "
+        "k taken are not the k smallest",
+        "sort them, and the columns with them: order = np.argsort(lam)",
+        when=lambda lam, right, c: (
+            np.all(np.abs(lam[:, None] - c.every[None, :]).min(axis=1) <= 1e-6 * c.every[-1]) and not agree(lam, right)
+        ),
+    ),
+    Wrong(
+        "the eigenvalues differ from the k smallest of C e = -lam M e on {label}",
+        "Q = -M^-1/2 C M^-1/2 and a symmetric solver",
+        when=lambda lam, right, c: True,
+        typical=False,
+    ),
 ]
 
 E_MISTAKES = [
-    Wrong("E holds the eigenvectors z of Q, not transformed back", "e = M^-1/2 z: E = Z / np.sqrt(m)[:, None]",
-          when=lambda a, right, c: _residual(a[1] / np.sqrt(c.m)[:, None], a[0], c)),
-    Wrong("the back-transform uses M^-1 instead of M^-1/2", "e = M^-1/2 z",
-          when=lambda a, right, c: _residual(a[1] * np.sqrt(c.m)[:, None], a[0], c)),
-    Wrong("the columns of E are not eigenvectors for these lam on {label} (C E + M E diag(lam) is not 0)",
-          "E[:, i] belongs to lam[i]: keep the columns in the order of their eigenvalues",
-          when=lambda a, right, c: not _residual(a[1], a[0], c), typical=False),
-    Wrong("the eigenvectors are normalised in the plain dot product (E^T E = I), not in M (E^T M E = I)",
-          "divide each column by its M-norm, sqrt(e^T M e)",
-          when=lambda a, right, c: np.allclose(np.einsum("ij,ij->j", a[1], a[1]), 1.0, rtol=1e-6)),
-    Wrong("the eigenvectors are not M-normalised: E^T M E is diagonal but not I", "divide each column by "
-          "sqrt(e^T M e)", when=lambda a, right, c: np.allclose(_gram(a[1], c), np.diag(np.diag(_gram(a[1], c))),
-                                                                atol=1e-6 * np.abs(_gram(a[1], c)).max())),
-    Wrong("E^T M E is not the identity on {label}: eigenvectors of one repeated eigenvalue are not M-orthogonal",
-          "take an orthonormal basis Z of each eigenspace of Q, as a symmetric solver returns",
-          when=lambda a, right, c: True, typical=False),
+    Wrong(
+        "E holds the eigenvectors z of Q, not transformed back",
+        "e = M^-1/2 z: E = Z / np.sqrt(m)[:, None]",
+        when=lambda a, right, c: _residual(a[1] / np.sqrt(c.m)[:, None], a[0], c),
+    ),
+    Wrong(
+        "the back-transform uses M^-1 instead of M^-1/2",
+        "e = M^-1/2 z",
+        when=lambda a, right, c: _residual(a[1] * np.sqrt(c.m)[:, None], a[0], c),
+    ),
+    Wrong(
+        "the columns of E are not eigenvectors for these lam on {label} (C E + M E diag(lam) is not 0)",
+        "E[:, i] belongs to lam[i]: keep the columns in the order of their eigenvalues",
+        when=lambda a, right, c: not _residual(a[1], a[0], c),
+        typical=False,
+    ),
+    Wrong(
+        "the eigenvectors are normalised in the plain dot product (E^T E = I), not in M (E^T M E = I)",
+        "divide each column by its M-norm, sqrt(e^T M e)",
+        when=lambda a, right, c: np.allclose(np.einsum("ij,ij->j", a[1], a[1]), 1.0, rtol=1e-6),
+    ),
+    Wrong(
+        "the eigenvectors are not M-normalised: E^T M E is diagonal but not I",
+        "divide each column by sqrt(e^T M e)",
+        when=lambda a, right, c: np.allclose(
+            _gram(a[1], c), np.diag(np.diag(_gram(a[1], c))), atol=1e-6 * np.abs(_gram(a[1], c)).max()
+        ),
+    ),
+    Wrong(
+        "E^T M E is not the identity on {label}: eigenvectors of one repeated eigenvalue are not M-orthogonal",
+        "take an orthonormal basis Z of each eigenspace of Q, as a symmetric solver returns",
+        when=lambda a, right, c: True,
+        typical=False,
+    ),
 ]
 
 
@@ -132,8 +174,11 @@ def eigenpairs(fn):
     for (label, V, F), k in zip(_meshes(case_rng()).values(), (6, 6, 4)):
         M, C = laplacian(V, F)
         m = M.diagonal()
-        cases.append(Case(label, M=M, C=C, k=k).but(m=m, every=_eig(C, 1 / np.sqrt(m))[0],
-                                                     plain=_eig(C, np.ones(len(m)))[0], inverse=_eig(C, 1 / m)[0]))
+        cases.append(
+            Case(label, M=M, C=C, k=k).but(
+                m=m, every=_eig(C, 1 / np.sqrt(m))[0], plain=_eig(C, np.ones(len(m)))[0], inverse=_eig(C, 1 / m)[0]
+            )
+        )
     solver = refusing(fn, GENERALISED, "reduce to Q = -M^-1/2 C M^-1/2 and use a symmetric solver on Q")
     answers = [pair(call(solver, c.M.copy(), c.C.copy(), c.k), len(c.m), c.k) for c in cases]
     judge(LAM_MISTAKES, cases, [lam for lam, _ in answers], right=lambda c: c.every[: c.k])
@@ -172,28 +217,61 @@ def _other_basis(c, **options):
 
 
 RECONSTRUCTION_MISTAKES = [
-    Wrong("the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs",
-          "E^T M E = I, so the coefficients are E_k^T M V", build=lambda c: _project(c, inner=lambda c, X: X)),
-    Wrong("V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)", "c = E_k^T M V",
-          build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None])),
-    Wrong("M multiplies the result (M E_k E_k^T V) instead of V inside the inner product", "V_k = E_k (E_k^T (M V))",
-          build=lambda c: _project(c, inner=lambda c, X: X, left=True)),
-    Wrong("C stands where M belongs in the inner product", "the coefficients are E_k^T M V",
-          build=lambda c: _project(c, inner=lambda c, X: c.C @ X)),
-    Wrong("the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes",
-          "E[:, :k], e_0 included, and E_k^T M V", build=lambda c: _project(c, first=1, inner=lambda c, X: X)),
-    Wrong("the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin",
-          "use E[:, :k], e_0 included", build=lambda c: _project(c, first=1)),
-    Wrong("k is off by one: one eigenvector too few", "E[:, :k] holds e_0 .. e_{k-1}",
-          build=lambda c: _project(c, k=c.k - 1)),
-    Wrong("k is off by one: one eigenvector too many", "E[:, :k] holds e_0 .. e_{k-1}",
-          build=lambda c: _project(c, k=c.k + 1)),
-    Wrong("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
-          "laplacian(V, F) with its default weights", build=lambda c: _other_basis(c, weights="uniform")),
-    Wrong("the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked",
-          "laplacian(V, F) with its default area", build=lambda c: _other_basis(c, area="mixed")),
-    Wrong("the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
-          "keep every row of C: the natural boundary condition needs no rule", build=_boundary_rows),
+    Wrong(
+        "the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs",
+        "E^T M E = I, so the coefficients are E_k^T M V",
+        build=lambda c: _project(c, inner=lambda c, X: X),
+    ),
+    Wrong(
+        "V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)",
+        "c = E_k^T M V",
+        build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None]),
+    ),
+    Wrong(
+        "M multiplies the result (M E_k E_k^T V) instead of V inside the inner product",
+        "V_k = E_k (E_k^T (M V))",
+        build=lambda c: _project(c, inner=lambda c, X: X, left=True),
+    ),
+    Wrong(
+        "C stands where M belongs in the inner product",
+        "the coefficients are E_k^T M V",
+        build=lambda c: _project(c, inner=lambda c, X: c.C @ X),
+    ),
+    Wrong(
+        "the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes",
+        "E[:, :k], e_0 included, and E_k^T M V",
+        build=lambda c: _project(c, first=1, inner=lambda c, X: X),
+    ),
+    Wrong(
+        "the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin",
+        "use E[:, :k], e_0 included",
+        build=lambda c: _project(c, first=1),
+    ),
+    Wrong(
+        "k is off by one: one eigenvector too few",
+        "E[:, :k] holds e_0 .. e_{k-1}",
+        build=lambda c: _project(c, k=c.k - 1),
+    ),
+    Wrong(
+        "k is off by one: one eigenvector too many",
+        "E[:, :k] holds e_0 .. e_{k-1}",
+        build=lambda c: _project(c, k=c.k + 1),
+    ),
+    Wrong(
+        "the uniform operator (valences, weights 1) is used where the cotangent one is asked",
+        "laplacian(V, F) with its default weights",
+        build=lambda c: _other_basis(c, weights="uniform"),
+    ),
+    Wrong(
+        "the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked",
+        "laplacian(V, F) with its default area",
+        build=lambda c: _other_basis(c, area="mixed"),
+    ),
+    Wrong(
+        "the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
+        "keep every row of C: the natural boundary condition needs no rule",
+        build=_boundary_rows,
+    ),
     Wrong("V_k differs from the M-orthogonal projection on {label}", "V_k = E_k (E_k^T M V)", typical=False),
 ]
 
@@ -203,17 +281,32 @@ def _positions(out, c):
         swapped = "diagonal" in str(out.error)
         raise Mistake(
             "(M, C) are swapped: laplacian returns M first" if swapped else f"the function raised {out.error!r}",
-            "M, C = laplacian(V, F)" if swapped else "run it on a small mesh and read the traceback", typical=swapped)
+            "M, C = laplacian(V, F)" if swapped else "run it on a small mesh and read the traceback",
+            typical=swapped,
+        )
     if np.shape(out) == (c.k, 3):
-        raise Mistake(f"the function returned the {c.k} x 3 coefficients E_k^T M V, not the positions",
-                      "multiply them back: V_k = E_k c", typical=False)
-    return positions(out, c.n, nan_hint="a square root of negative areas: are M and C swapped? M, C = laplacian(V, F)")
+        raise Mistake(
+            f"the function returned the {c.k} x 3 coefficients E_k^T M V, not the positions",
+            "multiply them back: V_k = E_k c",
+            typical=False,
+        )
+    if np.shape(out) == (c.n, 3) and np.asarray(out).dtype.kind == "f" and not np.isfinite(out).all():
+        raise Mistake(
+            "the positions are NaN, as when (M, C) are swapped: C's diagonal, negative, went in as the "
+            "vertex areas and under a square root",
+            "M, C = laplacian(V, F): M first",
+        )
+    return positions(out, c.n)
 
 
 @exercise(
     "spectral_reconstruction",
     reread=_REREAD,
-    forbid=("lessons.spectral.spectral_reconstruction", "lessons.spectral.spectral_basis", "lessons.spectral.SpectralBasis"),
+    forbid=(
+        "lessons.spectral.spectral_reconstruction",
+        "lessons.spectral.spectral_basis",
+        "lessons.spectral.SpectralBasis",
+    ),
 )
 def spectral_reconstruction(fn):
     """Check ``fn(V, F, k) -> V_k``: V_k = E_k E_k^T M V with E_k the first k eigenvectors (every k < n)."""
