@@ -8,7 +8,14 @@ from diagnoses import assert_diagnosed
 
 import geomlib
 from geomlib import check
-from geomlib.mesh.geometry import bounding_box_diagonal, mean_edge_length
+
+
+def bounding_box_diagonal(V):  # the answers below are written with numpy, as the ground rules ask
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+def mean_edge_length(V, F):
+    return float(np.linalg.norm(V[F] - V[np.roll(F, 1, axis=1)], axis=2).mean())
 
 
 @pytest.fixture(autouse=True)
@@ -46,11 +53,11 @@ WRONG_NOISE = {
     ),
     "in place": (
         lambda V, F, sigma, seed: V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed)),
-        "modified in place",
+        "changed its input V in place",
     ),
     "in place, copy returned": (
         lambda V, F, sigma, seed: np.copy(V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed))),
-        "modified in place",
+        "changed its input V in place",
     ),
     "not seeded": (
         lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.standard_normal(V.shape),

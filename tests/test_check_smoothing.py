@@ -151,7 +151,7 @@ LOOP_LEARNERS = {
     "multiplied by the vertex areas": explicit_areas(1.0),
     "uniform operator": lambda V, F, tau, N: explicit(V, F, tau, N, weights="uniform", refuse=False),
     "pull C_IB P_B is left out": lambda V, F, tau, N: explicit(V, F, tau, N, coupled=False),
-    "the caller's V was changed": lambda V, F, tau, N: explicit(V, F, tau, N, in_place=True),
+    "changed its input V in place": lambda V, F, tau, N: explicit(V, F, tau, N, in_place=True),
     "ran instead of being refused": lambda V, F, tau, N: explicit(V, F, tau, N, refuse=False),
 }
 
@@ -233,7 +233,7 @@ IMPLICIT_LEARNERS = {
     "term has the wrong sign": lambda V, F, tau, N: implicit(V, F, tau, N, coupling=-1.0),
     "these are explicit steps": lambda V, F, tau, N: explicit(V, F, tau, N, refuse=False),
     "uniform operator": lambda V, F, tau, N: implicit(V, F, tau, N, weights="uniform"),
-    "the caller's V was changed": lambda V, F, tau, N: implicit(V, F, tau, N, in_place=True),
+    "changed its input V in place": lambda V, F, tau, N: implicit(V, F, tau, N, in_place=True),
 }
 
 

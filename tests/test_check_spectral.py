@@ -11,7 +11,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from geomlib import boundary_vertices, check, laplacian
+from geomlib import check, laplacian
 from geomlib.teaching.check.spectral import E_MISTAKES, LAM_MISTAKES, RECONSTRUCTION_MISTAKES
 
 
@@ -142,7 +142,9 @@ def projection(
     m = M.diagonal()
     C = C.toarray()
     if zero_boundary:
-        C[boundary_vertices(F, len(V)), :] = 0.0
+        edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+        once, count = np.unique(edges, axis=0, return_counts=True)
+        C[np.unique(once[count == 1]), :] = 0.0  # the boundary vertices' rows
         E = la.eigh(-C, np.diag(m))[1]
     else:
         d = 1 / np.sqrt(m)

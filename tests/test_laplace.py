@@ -18,6 +18,7 @@ from geomlib.lessons.laplace import (
     mixed_areas,  # noqa: E402
     uniform_adjacency,
     uniform_laplacian,
+    voronoi_pieces,
 )
 
 AREAS = ("barycentric", "mixed")
@@ -373,8 +374,8 @@ def test_laplacian_measures_the_faces_once(monkeypatch):
     import geomlib.lessons.laplace as laplace
 
     calls = []
-    measure = laplace.face_geometry
-    monkeypatch.setattr(laplace, "face_geometry", lambda V, F: calls.append(1) or measure(V, F))
+    measure = laplace.FaceGeometry.of
+    monkeypatch.setattr(laplace.FaceGeometry, "of", lambda V, F: calls.append(1) or measure(V, F))
     V, F = surfaces.sphere(1.0, subdivisions=2).V, surfaces.sphere(1.0, subdivisions=2).F
     for area in ("barycentric", "mixed"):
         calls.clear()
@@ -382,6 +383,18 @@ def test_laplacian_measures_the_faces_once(monkeypatch):
         assert len(calls) == 1
         np.testing.assert_array_equal(C.toarray(), cotangent_matrix(V, F).toarray())
         np.testing.assert_array_equal(M.diagonal(), vertex_areas(V, F, area))
+
+
+def test_voronoi_pieces_fill_each_triangle_and_are_the_mixed_areas_without_an_obtuse_angle():
+    # the three circumcentric pieces of a triangle sum to its area, obtuse or not (signed areas)
+    V = np.array([[0.0, 0, 0], [4, 0, 0], [1, 1, 0], [2, -1.5, 0.3]])
+    F = np.array([[0, 1, 2], [0, 3, 1]])
+    pieces = voronoi_pieces(V, F)
+    assert np.allclose(pieces.sum(axis=1), face_geometry(V, F)[1] / 2)
+    assert pieces[0, 0] < 0  # at vertex 0 of the obtuse triangle: its other two angles differ by more than 90 degrees
+    s = surfaces.sphere(1.0, subdivisions=1)  # the icosphere has no obtuse triangle
+    summed = np.bincount(s.F.ravel(), voronoi_pieces(s.V, s.F).ravel(), minlength=len(s.V))
+    assert np.allclose(summed, mixed_areas(s.V, s.F))
 
 
 def test_intrinsic_cotangent_matrix_of_a_3_4_5_triangle_is_exact():

@@ -658,6 +658,29 @@ def test_frame_keeps_a_collapsed_mesh_at_the_input_scale(sphere):
     assert view._distance == distance and covered(view) < 0.01 * covered(MeshView(V, F))
 
 
+def test_fit_draws_a_collapse_or_an_explosion_at_the_frames_size_and_says_so(sphere):
+    V, F = sphere
+    view = MeshView(V, F, title="smoothing", fit=True)
+
+    def covered():
+        return np.any(view.still()[18 : 18 + view.height] < 245, axis=2).mean()
+
+    full = covered()
+    view.update(V=0.5 * V + 0.1)  # shrunk to half: drawn as it is, so the shrinkage is seen
+    assert view._title.value == "<b>smoothing</b>" and 0.15 * full < covered() < 0.35 * full
+    view.update(V=1e-6 * V + 0.3)  # collapsed: a speck, drawn a million times larger at the frame's centre
+    assert "drawn 1e+06 x larger" in view._title.value and "drawn 1e+06 times larger" in view.alt_text()
+    assert covered() == pytest.approx(full, rel=0.02)
+    stretched = V * [30.0, 1.0, 1.0]  # a volume kept by a large stretch: out of the frame, drawn smaller
+    view.update(V=stretched)
+    assert "drawn 17.3 x smaller" in view._title.value  # the bounding boxes' diagonals: sqrt(902 / 3)
+    picture = np.any(view.still()[18 : 18 + view.height] < 245, axis=2)
+    assert picture.any() and not (picture[0].any() or picture[-1].any() or picture[:, 0].any() or picture[:, -1].any())
+    view.update(V=V)
+    assert view._title.value == "<b>smoothing</b>" and covered() == pytest.approx(full)
+    assert MeshView(1e-6 * V, F, frame=V)._fitted == 1.0  # without fit: the frame's scale, always
+
+
 def test_linked_views_of_very_different_sizes_are_not_specks(sphere):
     V, F = sphere
     big = 28.0 * V  # fandisk_ns is 28 times plane_ns

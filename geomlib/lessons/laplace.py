@@ -31,20 +31,30 @@ Names: a function called ``*_laplacian`` returns the pair ``(M, C)``
 (:func:`laplacian`, :func:`uniform_laplacian`, and the ``cotangent_laplacian``
 a learner writes in notebook 03); one called ``*_matrix`` or ``*_areas``
 returns one matrix or one vector (:func:`cotangent_matrix`, :func:`vertex_areas`).
+
+Validation: each public function checks its mesh once, at its door
+(:func:`geomlib.mesh.validate.as_mesh`), and measures its faces once
+(:class:`FaceGeometry`); the functions it composes take that record as ``faces=``
+and read (V, F) as checked. :func:`assemble_laplacian` is :func:`laplacian` for a
+checked mesh, the one the operator and the curvature lessons compose.
 """
 
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..mesh.errors import MeshWarning, format_indices
-from ..mesh.geometry import corner_positions, cross, face_blocks
+from ..mesh.geometry import FACE_BLOCK, corner_positions, cross, face_blocks
 from ..mesh.topology import edges
-from ..mesh.validate import as_mesh, check_choice, is_zero_area
+from ..mesh.validate import as_faces, as_mesh, check_choice, is_zero_area
 
 __all__ = [
     "laplacian",
+    "assemble_laplacian",
+    "graph_laplacian",
+    "FaceGeometry",
     "uniform_laplacian",
     "cotangent_matrix",
     "intrinsic_cotangent_matrix",
@@ -74,14 +84,16 @@ def check_options(weights=None, area=None):
         check_choice("area", area, AREAS)
 
 
-def face_geometry(V, F):
-    """Per face: squared edge lengths, twice the area, corner cotangents, zero-area flag.
+class FaceGeometry(NamedTuple):
+    """Per face of a checked mesh: what the cotangent Laplacian and the vertex areas read, measured once.
 
     Corner ``i`` of face ``(v0, v1, v2)`` sits opposite the edge ``e_i = v_k - v_j``
-    (``j, k`` the next two corners).
+    (``j, k`` the next two corners). A public call measures it once at its door
+    (:meth:`of`, after :func:`geomlib.mesh.validate.as_mesh`) and hands it to the
+    functions it composes as ``faces=``.
 
-    Returns
-    -------
+    Fields
+    ------
     l2 : (m, 3) float64
         ``l2[f, i] = |e_i|^2`` (length^2).
     dblA : (m,) float64
@@ -92,12 +104,44 @@ def face_geometry(V, F):
     degenerate : (m,) bool
         Zero-area faces (:func:`geomlib.mesh.validate.is_zero_area`).
     """
+
+    l2: np.ndarray
+    dblA: np.ndarray
+    cot: np.ndarray
+    degenerate: np.ndarray
+
+    @classmethod
+    def of(cls, V, F):
+        """The record of a checked (V, F) (as ``as_mesh`` returns them), measured block by block.
+
+        Only one block's corner temporaries exist at a time (:func:`blocks`): at 655k vertices
+        tens of MB instead of hundreds.
+        """
+        if len(F) <= FACE_BLOCK:
+            return cls(*corner_geometry(*corner_positions(V, F)))
+        parts = [faces for _, faces in cls.blocks(V, F)]
+        return cls(*(np.concatenate(field) for field in zip(*parts)))
+
+    @classmethod
+    def blocks(cls, V, F):
+        """``(block, record of block)`` for each of ``geomlib.mesh.geometry.face_blocks(F)`` (checked V, F)."""
+        Vt = np.ascontiguousarray(V.T).T  # V, transposed once: corner_positions then copies nothing per block
+        for block in face_blocks(F):
+            yield block, cls(*corner_geometry(*corner_positions(Vt, block)))
+
+
+def face_geometry(V, F):
+    """The :class:`FaceGeometry` of (V, F): squared edge lengths, twice the areas, corner cotangents, zero-area flags.
+
+    Unpacks as ``l2, dblA, cot, degenerate = face_geometry(V, F)``; see :class:`FaceGeometry`
+    for the shapes and units.
+    """
     V, F = as_mesh(V, F)
-    return corner_geometry(*corner_positions(V, F))
+    return FaceGeometry.of(V, F)
 
 
 def corner_geometry(v0, v1, v2):
-    """:func:`face_geometry` from the (3, m) coordinate rows of the corners (unchecked input)."""
+    """:class:`FaceGeometry`'s fields from the (3, m) coordinate rows of the corners (unchecked input)."""
     e = (v2 - v1, v0 - v2, v1 - v0)  # e_i = v_k - v_j, the edge opposite corner i
     l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])  # |e_i|^2, (3, m)
     N2 = cross(e[1], e[2])  # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
@@ -107,40 +151,6 @@ def corner_geometry(v0, v1, v2):
     cot[:, degenerate] = 0.0
     # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
     return l2.T, dblA, cot.T, degenerate
-
-
-def measured_blocks(V, F):
-    """``(block, face_geometry(V, block))`` for each of ``geomlib.mesh.geometry.face_blocks(F)``.
-
-    Unchecked input: the caller has validated V and F, once rather than once per block. A sum
-    over faces done this way holds one block's corner temporaries at a time: at 655k vertices
-    tens of MB instead of hundreds.
-    """
-    Vt = np.ascontiguousarray(V.T).T  # V, transposed once: corner_positions then copies nothing per block
-    for block in face_blocks(F):
-        yield block, corner_geometry(*corner_positions(Vt, block))
-
-
-def measured_faces(V, F):
-    """:func:`face_geometry`, with one MeshWarning naming the zero-area faces, if there are any.
-
-    They contribute nothing to the cotangent Laplacian and the vertex areas.
-    """
-    faces = face_geometry(V, F)
-    warn_zero_area(faces[3], stacklevel=4)
-    return faces
-
-
-def measured_areas(V, F):
-    """Twice the area (m,) and the zero-area flag (m,) of every face, as :func:`face_geometry` gives them.
-
-    Measured block by block (:func:`measured_blocks`); warns as :func:`measured_faces` does.
-    """
-    blocks = [faces[1::2] for _, faces in measured_blocks(V, F)]  # keep (dblA, degenerate) only
-    dblA = np.concatenate([b[0] for b in blocks])
-    degenerate = np.concatenate([b[1] for b in blocks])
-    warn_zero_area(degenerate, stacklevel=4)
-    return dblA, degenerate
 
 
 def warn_zero_area(degenerate, stacklevel=3):
@@ -169,7 +179,11 @@ def uniform_laplacian(V, F):
     C : (n, n) scipy.sparse CSR float64
     """
     V, F = as_mesh(V, F)
-    n = len(V)
+    return graph_laplacian(len(V), F)
+
+
+def graph_laplacian(n, F):
+    """:func:`uniform_laplacian` of n vertices and checked faces F: ``(diag(valence), C)``."""
     E = edges(F)  # each edge ij once, i < j
     ones = np.ones(len(E))
     adjacency = sp.coo_matrix(
@@ -187,7 +201,7 @@ def edge_lengths(V, F):
     Everything the cotangent Laplacian needs of the geometry (:func:`intrinsic_cotangent_matrix`).
     """
     V, F = as_mesh(V, F)
-    return np.sqrt(face_geometry(V, F)[0])
+    return np.sqrt(FaceGeometry.of(V, F).l2)
 
 
 def intrinsic_cotangent_matrix(l, F, n=None, dblA=None):
@@ -234,20 +248,22 @@ def cotangent_matrix(V, F):
     Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
     """
     V, F = as_mesh(V, F)
-    l2, dblA, _, _ = face_geometry(V, F)
-    return intrinsic_cotangent_matrix(np.sqrt(l2), F, len(V), dblA)
+    faces = FaceGeometry.of(V, F)
+    return intrinsic_cotangent_matrix(np.sqrt(faces.l2), F, len(V), faces.dblA)
 
 
 def barycentric_areas(V, F, faces=None):
     """(n,) vertex areas A_i in length^2: a third of the area of every incident triangle.
 
     Zero-area triangles add 0 (MeshWarning), so a vertex in no other triangle
-    has area 0. Sums to the surface area. ``faces``: :func:`face_geometry` of (V, F)
-    when the caller has it already (then no warning: the caller gives it).
+    has area 0. Sums to the surface area. ``faces``: the :class:`FaceGeometry` of (V, F)
+    when the caller has checked (V, F) and measured it (then no warning: the caller gives it).
     """
-    V, F = as_mesh(V, F)
-    dblA, degenerate = (faces[1], faces[3]) if faces else measured_areas(V, F)
-    third = np.where(degenerate, 0.0, dblA / 6.0)
+    if faces is None:  # a call of its own: its door
+        V, F = as_mesh(V, F)
+        faces = FaceGeometry.of(V, F)
+        warn_zero_area(faces.degenerate)
+    third = np.where(faces.degenerate, 0.0, faces.dblA / 6.0)
     return np.bincount(F.ravel(), np.repeat(third, 3), minlength=len(V))  # to each of the 3 corners
 
 
@@ -257,10 +273,12 @@ def voronoi_pieces(V, F, faces=None):
     The circumcentric region of corner i inside its triangle, a signed area in length^2: it
     leaves the triangle when the triangle is obtuse, and is negative at corner i exactly when
     the other two angles differ by more than 90 degrees (notebook 03, section 2).
-    ``faces`` as in :func:`cotangent_matrix`.
+    ``faces`` as in :func:`barycentric_areas`.
     """
-    l2, _, cot, _ = faces or face_geometry(V, F)
-    lc = l2 * cot
+    if faces is None:
+        V, F = as_mesh(V, F)
+        faces = FaceGeometry.of(V, F)
+    lc = faces.l2 * faces.cot
     return (lc[:, NEXT] + lc[:, PREV]) / 8.0
 
 
@@ -277,14 +295,16 @@ def mixed_areas(V, F, faces=None):
     Sums to the surface area. Zero-area triangles add 0 (MeshWarning).
     ``faces`` as in :func:`barycentric_areas`.
     """
-    V, F = as_mesh(V, F)
-    l2, dblA, cot, degenerate = faces or measured_faces(V, F)
-    A = 0.5 * dblA[:, None]
-    voronoi = voronoi_pieces(V, F, (l2, dblA, cot, degenerate))
-    obtuse = cot < 0  # cot theta < 0 <=> theta > pi/2
+    if faces is None:  # a call of its own: its door
+        V, F = as_mesh(V, F)
+        faces = FaceGeometry.of(V, F)
+        warn_zero_area(faces.degenerate)
+    A = 0.5 * faces.dblA[:, None]
+    voronoi = voronoi_pieces(V, F, faces)
+    obtuse = faces.cot < 0  # cot theta < 0 <=> theta > pi/2
     obtuse_triangle = obtuse.any(axis=1, keepdims=True)
     per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
-    per_corner[degenerate] = 0.0
+    per_corner[faces.degenerate] = 0.0
     return np.bincount(F.T.ravel(), per_corner.T.ravel(), minlength=len(V))
 
 
@@ -335,16 +355,21 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     """
     check_options(weights, area)
     V, F = as_mesh(V, F)
+    return assemble_laplacian(V, F, weights, area)
+
+
+def assemble_laplacian(V, F, weights="cotan", area="barycentric"):
+    """:func:`laplacian` of a checked mesh ((V, F) as ``as_mesh`` returns them, options checked)."""
     if weights == "uniform":
-        return uniform_laplacian(V, F)
-    faces = face_geometry(V, F)  # once for both matrices
-    C = intrinsic_cotangent_matrix(np.sqrt(faces[0]), F, len(V), faces[1])  # names the zero-area faces, if any
+        return graph_laplacian(len(V), F)
+    faces = FaceGeometry.of(V, F)  # once for both matrices
+    C = intrinsic_cotangent_matrix(np.sqrt(faces.l2), F, len(V), faces.dblA)  # names the zero-area faces, if any
     return sp.diags(vertex_areas(V, F, area, faces)), C
 
 
 def uniform_adjacency(n, F):
     """Adjacency matrix (n, n) CSR float64 with 1 for every edge ij (each edge once, both directions)."""
-    M, C = uniform_laplacian(np.zeros((n, 3)), F)
+    M, C = graph_laplacian(n, as_faces(F, n))
     A = (C + M).tocsr()
     A.eliminate_zeros()
     return A

@@ -96,6 +96,7 @@ def _same(x, y):
     "fundamental_forms",
     reread="The definitions and Steps 1-2 · the tangents p_u, p_v and the inward normal p_u x p_v / |p_u x p_v| = -n",
     forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
+    tools=("sympy", "numpy", "scipy"),
 )
 def fundamental_forms(fn):
     """Check ``fn(a, b, c, u, v) -> (E, F, G, e, f, g)`` (or ``(I, II)``) for the ellipsoid, by value."""
@@ -177,6 +178,7 @@ _PHIS = np.array([0.0, 0.4, 1.1, np.pi / 2, 2.5, 4.0])
         "lessons.symbolic.ParametricSurface",
         "lessons.symbolic.ellipsoid",
     ),
+    tools=("numpy", "scipy", "sympy"),
 )
 def normal_curvature(fn):
     """Check ``fn(a, b, c, phi) -> kappa_n`` at (a, 0, 0), phi in radians from p_u (numbers or sympy numbers)."""

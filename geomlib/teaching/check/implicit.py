@@ -136,6 +136,7 @@ IMPLICIT_MISTAKES = [
         "lessons.operator.laplace_operator",
     ),
     own=("lessons.smoothing.implicit_smoothing", "lessons.smoothing.implicit_step", "lessons.operator.LaplaceOperator"),
+    allow=("lessons.laplace.laplacian", "mesh.topology.boundary_vertices"),
 )
 def implicit_loop(fn):
     """Check ``fn(V, F, tau, N) -> P``: N implicit steps by the interior block system, M and C of V built once."""

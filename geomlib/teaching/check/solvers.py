@@ -3,15 +3,19 @@
 Notebook 04 asks for the reduction of ``C e = -lam M e`` to the symmetric ``Q z = lam z``:
 a generalised solver handed the pair (``scipy.linalg.eigh(A, B)``, ``eigsh(A, k, M)``)
 would do it for the learner. Notebook 05 asks for lambda_max by products with Q: a
-dense solver computes all n eigenvalues (n^3 work) instead. :func:`refusing` wraps the
-learner's function so that such a call, however the routine was imported, fails the
-check with no points and names the routine.
+dense solver computes all n eigenvalues (n^3 work) instead. ``with refusing(watch, fn,
+why): ...`` fails the check with no points, naming the routine, when the learner's code
+calls one of them during the block.
 
-A call counts as the learner's when nothing but scipy's batching wrapper stands between
-it and code outside numpy, scipy and geomlib: their own solvers may call these routines inside
-(``lobpcg`` calls ``eigh`` with a second matrix), and that is not the learner's doing.
+Tripwires, not a profile (the profile belongs to the check's fence, ``fence``, which
+refuses a second one): for the block, each watched routine is replaced by a wrapper in
+its public module (``scipy.linalg``, ``numpy.linalg``, ``scipy.sparse.linalg``) and in the
+learner's globals (``from scipy.linalg import eigh``) and closure. scipy's own code keeps its module-
+internal references (``lobpcg`` calls ``eigh`` with a second matrix), so only the learner's
+calls are seen.
 """
 
+import contextlib
 import inspect
 import sys
 
@@ -23,72 +27,78 @@ from .result import Mistake
 
 __all__ = ["GENERALISED", "DENSE", "refusing"]
 
-
-def _watch(table):
-    """{code object: (public name, the argument that makes the call a refused one, or None: every call)}."""
-    return {inspect.unwrap(f).__code__: (name, argument) for name, (f, argument) in table.items()}
-
-
-#: Generalised solvers: refused when the second matrix is given.
-GENERALISED = _watch(
-    {
-        "scipy.linalg.eigh": (scipy.linalg.eigh, "b"),
-        "scipy.linalg.eigvalsh": (scipy.linalg.eigvalsh, "b"),
-        "scipy.linalg.eig": (scipy.linalg.eig, "b"),
-        "scipy.linalg.eigvals": (scipy.linalg.eigvals, "b"),
-        "scipy.sparse.linalg.eigsh": (scipy.sparse.linalg.eigsh, "M"),
-        "scipy.sparse.linalg.eigs": (scipy.sparse.linalg.eigs, "M"),
-        "scipy.sparse.linalg.lobpcg": (scipy.sparse.linalg.lobpcg, "B"),
-    }
-)
+#: Generalised solvers: refused when the second matrix is given. public name -> (module, argument)
+GENERALISED = {
+    "scipy.linalg.eigh": (scipy.linalg, "b"),
+    "scipy.linalg.eigvalsh": (scipy.linalg, "b"),
+    "scipy.linalg.eig": (scipy.linalg, "b"),
+    "scipy.linalg.eigvals": (scipy.linalg, "b"),
+    "scipy.sparse.linalg.eigsh": (scipy.sparse.linalg, "M"),
+    "scipy.sparse.linalg.eigs": (scipy.sparse.linalg, "M"),
+    "scipy.sparse.linalg.lobpcg": (scipy.sparse.linalg, "B"),
+}
 
 #: Dense solvers of all n eigenpairs: refused whatever their arguments.
-DENSE = _watch(
-    {
-        f"{module.__name__}.{name}": (getattr(module, name), None)
-        for module in (np.linalg, scipy.linalg)
-        for name in ("eigh", "eigvalsh", "eig", "eigvals")
-    }
-)
-
-_LIBRARIES = ("numpy", "scipy", "geomlib")  # geomlib's own calls are judged by its ground rules (result.call)
+DENSE = {
+    f"{module.__name__}.{name}": (module, None)
+    for module in (np.linalg, scipy.linalg)
+    for name in ("eigh", "eigvalsh", "eig", "eigvals")
+}
 
 
-def _learners(frame):
-    """Whether the call in ``frame`` comes from outside numpy, scipy and geomlib (past scipy's batching wrapper)."""
-    caller = frame.f_back
-    while caller is not None and caller.f_code.co_filename.endswith(("_lib/_util.py", "_lib\\_util.py")):
-        caller = caller.f_back
-    return caller is not None and not str(caller.f_globals.get("__name__", "")).startswith(_LIBRARIES)
+def _wire(name, original, argument, hits):
+    signature = inspect.signature(original)
+
+    def wired(*args, **kwargs):
+        caller = str(sys._getframe(1).f_globals.get("__name__", ""))
+        given = argument is None and not caller.startswith("geomlib")  # geomlib's own calls: the fence's business
+        if not given:
+            try:
+                given = (
+                    not caller.startswith("geomlib")
+                    and signature.bind_partial(*args, **kwargs).arguments.get(argument) is not None
+                )
+            except TypeError:
+                given = False
+        if given and not hits:
+            hits.append(name if argument is None else f"{name} with a second matrix ({argument}=)")
+        return original(*args, **kwargs)
+
+    return wired
 
 
-def refusing(fn, watch, why):
-    """``fn`` wrapped: a call of a routine in ``watch`` (see :data:`GENERALISED`, :data:`DENSE`) made by the
-    learner's code raises a ``Mistake`` (no partial credit) naming it, with ``why`` as the hint."""
-
-    def wrapped(*args):
-        hits, previous = [], sys.getprofile()
-
-        def profile(frame, event, arg):
-            if previous is not None:  # the geomlib ground rules of ``result.call`` keep watching
-                previous(frame, event, arg)
-            if event == "call" and not hits and frame.f_code in watch:
-                name, argument = watch[frame.f_code]
-                if (argument is None or frame.f_locals.get(argument) is not None) and _learners(frame):
-                    hits.append(name if argument is None else f"{name} with a second matrix ({argument}=)")
-
-        sys.setprofile(profile)
-        try:
-            out = fn(*args)
-        finally:
-            sys.setprofile(previous)
-        if hits:
-            raise Mistake(
-                f"the function calls {hits[0]}, which the ground rules exclude, so it earns no points",
-                why,
-                typical=False,
-            )
-        return out
-
-    wrapped.__name__ = getattr(fn, "__name__", "function")
-    return wrapped
+@contextlib.contextmanager
+def refusing(watch, fn, why):
+    """Within the block, a call of a routine of ``watch`` (:data:`GENERALISED`, :data:`DENSE`) made by the
+    learner's ``fn`` raises a ``Mistake`` (no partial credit) naming it, with ``why`` as the hint."""
+    hits, swapped = [], []
+    spaces = [getattr(fn, "__globals__", {})]
+    cells = [cell for cell in getattr(fn, "__closure__", None) or () if cell.cell_contents is not None]
+    for name, (module, argument) in watch.items():
+        attribute = name.rpartition(".")[2]
+        original = getattr(module, attribute)
+        wired = _wire(name, original, argument, hits)
+        for space in [vars(module), *spaces]:
+            for key, value in list(space.items()):
+                if value is original:
+                    swapped.append((space, key, value))
+                    space[key] = wired
+        for cell in cells:  # a routine imported inside the function that made fn
+            if cell.cell_contents is original:
+                swapped.append((cell, None, original))
+                cell.cell_contents = wired
+    try:
+        yield
+    except Mistake as m:
+        if not hits or "earns no points" in m.diagnosis:  # the fence's refusal comes first
+            raise
+    finally:
+        for space, key, value in reversed(swapped):
+            if key is None:
+                space.cell_contents = value
+            else:
+                space[key] = value
+    if hits:
+        raise Mistake(
+            f"the function calls {hits[0]}, which the ground rules exclude, so it earns no points", why, typical=False
+        )

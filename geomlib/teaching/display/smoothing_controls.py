@@ -85,24 +85,26 @@ def explicit_explorer(meshes, steps, limits, iterations):
 
 
 def implicit_explorer(V, F, steps, name, iterations, limit):
-    """Notebook 06's mesh ``name`` under a step slider two decades either side of its STEP, an iteration
+    """Notebook 06's mesh ``name`` under a step slider from STEP / 100 to 10 STEP, an iteration
     slider, the volume switch (closed meshes only) and the operator, fixed (built once) or rebuilt every step.
 
-    The step slider's positions are factorised ahead (17 of them, or 3 above ``LARGE_MESH`` vertices, said in a
-    note); ``limit`` is the mesh's explicit limit, for the read-out.
+    The step slider's positions are factorised ahead (13 of them, or 4 above ``LARGE_MESH`` vertices, said in a
+    note); ``limit`` is the mesh's explicit limit, for the read-out. The view keeps the input's framing until the
+    result is smaller than a quarter of the input or leaves the frame; then it is drawn scaled (``fit``).
     """
     import ipywidgets
 
-    grid = 0.25 if len(V) <= LARGE_MESH else 2.0  # slider positions: the step x 10^(grid k)
+    grid = 0.25 if len(V) <= LARGE_MESH else 1.0  # slider positions: the step x 10^(grid k)
     if len(V) > LARGE_MESH:
         note(
-            "{name} has {n} vertices: the step slider gets 3 positions (STEP / 100, STEP, 100 STEP) instead of 17, "
-            "each a factorisation prepared now.",
+            "{name} has {n} vertices: the step slider gets 4 positions (STEP / 100 to 10 STEP, a decade apart) "
+            "instead of 13, each a factorisation prepared now.",
             name=name.upper(),
             n=len(V),
         )
     value = steps.values[name]
-    step_slider = log_slider(value, value / 100, value * 100, step_label(steps.unit), grid)
+    # up to 10 STEP, not 100 STEP: 50 steps of that leave a needle too thin to draw
+    step_slider = log_slider(value, value / 100, value * 10, step_label(steps.unit), grid)
     positions = log_positions(step_slider)
     smoother = ImplicitSmoother(V, F).prepare([steps.absolute(name, s) for s in positions], iterations)
     closed = len(boundary_vertices(F, len(V))) == 0
@@ -122,6 +124,7 @@ def implicit_explorer(V, F, steps, name, iterations, limit):
         vmin=0.0,
         vmax=0.05,
         title="implicit smoothing",
+        fit=True,
         label="|displacement| / diagonal",
         description="how far smoothing moved each vertex; sharp edges move most",
     )
@@ -142,4 +145,6 @@ def implicit_explorer(V, F, steps, name, iterations, limit):
         )
         return f"tau = {tau:.3g} ({tau / limit:.3g} x the explicit limit); {volume}"
 
-    return live(update, controls, view)
+    knobs = live(update, controls, view)
+    knobs.view, knobs.positions, knobs.value = view, positions, value  # for a test that walks every position
+    return knobs

@@ -301,6 +301,13 @@ class MeshView:
         Positions whose bounding box frames the camera, e.g. the input mesh when
         V is its smoothed result: a mesh that shrank or collapsed is then drawn
         at the input's scale. Default: V itself.
+    fit : bool
+        Keep the mesh readable whatever an update does to its size: a mesh
+        smaller than ``SPECK_RATIO`` times its frame (a collapse), or one that
+        leaves the frame's bounding sphere (an explosion, a volume kept by a
+        large stretch), is drawn scaled about its own centre to the frame's size,
+        put at the frame's centre, and its title says "drawn N x larger" (or
+        smaller). In between it is drawn as it is, so shrinkage is seen.
     zero_tol : float >= 0
         A field whose finite values all lie within ``zero_tol`` of zero (in the
         values' units) is zero up to rounding: drawn in ``ZERO_COLOR`` (white),
@@ -340,6 +347,7 @@ class MeshView:
         frame=None,
         zero_tol=ZERO_TOL,
         description=None,
+        fit=False,
     ):
         import ipywidgets as widgets
         import pythreejs as three
@@ -368,6 +376,8 @@ class MeshView:
         self.zero_tol = float(zero_tol)
         self._centre, self._radius = bounding_frame(V if frame is None else as_vertices(frame, where="frame"))
         self._scale = 1.0  # drawn this many times larger (side_by_side enlarges specks)
+        self.fit = bool(fit)
+        self._fitted = self._fit_factor(V)  # and this many times larger about its own centre (``fit``)
         self._distance = camera_distance(self._radius, self.width, self.height)
 
         # one interleaved float32 buffer: position (0:3), normal (3:6), colour (6:9)
@@ -490,10 +500,37 @@ class MeshView:
         finite = self._values[np.isfinite(self._values)]
         return bool(finite.size) and float(np.abs(finite).max()) <= self.zero_tol
 
+    def _fit_factor(self, V):
+        """How many times larger V is drawn under ``fit``: 1 while it is at least ``SPECK_RATIO`` of
+        its frame and inside the frame's bounding sphere (which the camera shows whole), else the
+        frame's size over V's."""
+        if not self.fit:
+            return 1.0
+        centre, radius = bounding_frame(V)
+        reach = float(np.linalg.norm(V - self._centre, axis=1).max())
+        if radius < SPECK_RATIO * self._radius or reach > self._radius:
+            return self._radius / radius
+        return 1.0
+
+    def _shown(self):
+        """(n, 3) float64: the positions as drawn (V, or V scaled by ``fit`` about its centre onto the frame's)."""
+        if self._fitted == 1.0:
+            return self._V
+        return self._centre + self._fitted * (self._V - bounding_frame(self._V)[0])
+
+    def _size_note(self):
+        """ "drawn N x larger" (or smaller) when the picture is not to the frame's scale, else ""."""
+        scale = self._scale * self._fitted
+        if scale == 1.0:
+            return ""
+        if scale < 1.0:
+            return f"drawn {1 / scale:.3g} x smaller"
+        return f"drawn {scale:.3g} x larger"
+
     def _title_text(self):
         text = f"<b>{html.escape(self.title)}</b>" if self.title else ""
-        if self._scale != 1.0:
-            text += f" <i>(drawn {self._scale:.3g} x larger)</i>"
+        if self._size_note():
+            text += f" <i>({self._size_note()})</i>"
         return text
 
     def _colors(self):
@@ -512,7 +549,7 @@ class MeshView:
         if V:
             # positions relative to the first bounding-box centre (float32 keeps
             # its precision near the origin)
-            buf[:, 0:3] = self._V - self._centre
+            buf[:, 0:3] = self._shown() - self._centre
             buf[:, 3:6] = view_normals(self._V, self._triangles)
         else:
             buf[:, 0:6] = old[:, 0:6]
@@ -554,8 +591,8 @@ class MeshView:
         """
         mesh = f"a mesh of {self._n} vertices and {self._F.shape[0]} faces"
         text = f"3D view of {self.title}: {mesh}" if self.title else f"3D view of {mesh}"
-        if self._scale != 1.0:
-            text += f", drawn {self._scale:.3g} times larger"
+        if self._size_note():
+            text += f", {self._size_note().replace(' x ', ' times ')}"
         name = self.label or "the values"
         if self._values is None:
             text += ", plain shading (no colour map)."
@@ -604,6 +641,10 @@ class MeshView:
         new_V = V is not None
         if new_V:
             self._V = _check_count(as_vertices(V), self._n)
+            fitted, self._fitted = self._fitted, self._fit_factor(self._V)
+            if fitted != self._fitted:
+                self._title.value = self._title_text()
+                self._title.layout.display = None if self._title.value else "none"
         new_colors = False
         if values is not None:
             self._values = _check_values(values, self._n)
@@ -630,7 +671,7 @@ class MeshView:
         """(h, w, 3) uint8 still picture: the first camera view, title and colour bar."""
         buf = self._buffer.array
         image = render_still(
-            self._V,
+            self._shown(),
             self._F,
             buf[:, 6:9],
             buf[:, 3:6].astype(np.float64),
@@ -646,8 +687,8 @@ class MeshView:
         lo, hi = self.range
         lut = self._lut if self._values is not None and not self.is_zero else None
         title = self.title
-        if title and self._scale != 1.0:
-            title = f"{title} (drawn {self._scale:.3g} x larger)"
+        if title and self._size_note():
+            title = f"{title} ({self._size_note()})"
         if self.is_zero:
             title = f"{title or ''}  [{self.label or 'values'}: 0 everywhere]".strip()
         return still_with_colorbar(image, lut, lo, hi, self.label or "", title)
@@ -657,8 +698,8 @@ class MeshView:
         text = f"MeshView: {self._n} vertices, {self._F.shape[0]} faces"
         if self.title:
             text = f"{text} ({self.title})"
-        if self._scale != 1.0:
-            text += f", drawn {self._scale:.3g} x larger"
+        if self._size_note():
+            text += f", {self._size_note()}"
         if self._values is not None and self.is_zero:
             text += f"; {self.label or 'values'}: {self._zero_text()}, drawn white"
         elif self._values is not None:

@@ -235,7 +235,8 @@ def smoothing_sweep(
     -------
     SmoothingSweep
     """
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    if comparison is None:
+        comparison = MeshComparison(V_clean, F)
     iterations = np.asarray(sorted(set(int(k) for k in iterations)), dtype=np.int64)
     if len(iterations) == 0 or iterations[0] < 1:
         raise MeshError("iterations must be positive whole numbers")
@@ -252,7 +253,7 @@ def smoothing_sweep(
         bar = tqdm(total=runs, desc="smoothing sweep")
 
     def sweep(levels, bar):
-        _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterations, bar)
+        _sweep_levels(comparison, out, levels, seed, direction, schemes, step_values, iterations, bar)
 
     def rows(levels):
         found = {("values", k): v[levels] for k, v in out.values.items()}
@@ -284,7 +285,7 @@ def _run_levels(sweep, rows, put, count, out, bar, workers):
     out.seconds = time.perf_counter() - start
 
 
-def _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterations, bar):
+def _sweep_levels(comparison, out, levels, seed, direction, schemes, step_values, iterations, bar):
     """The runs of :func:`smoothing_sweep` at the noise levels ``levels`` (indices), recorded into ``out``."""
     where = {int(k): l for l, k in enumerate(iterations)}
     last = int(iterations[-1])
@@ -292,22 +293,22 @@ def _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterati
     # M - step C, serves every noise level (it smooths each noisy mesh from P = Vn)
     shared = {}
     for i in levels:
-        Vn = add_noise(C.V_clean, C.F, out.sigmas[i], seed, direction=direction)
-        for key, value in C.evaluate(Vn, hausdorff=False).items():
+        Vn = add_noise(comparison.V_clean, comparison.F, out.sigmas[i], seed, direction=direction)
+        for key, value in comparison.evaluate(Vn, hausdorff=False).items():
             out.noisy[key][i] = value
         for j, (method, weights) in enumerate(schemes):
             smoother = shared.get((method, weights))
             if smoother is None:
-                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
+                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, comparison.F, weights)
                 if method == "implicit" and weights == "uniform":
                     shared[method, weights] = smoother
             for k, value in enumerate(step_values[method]):
-                step = scale_free_step(Vn, C.F, method, weights, value)
+                step = scale_free_step(Vn, comparison.F, method, weights, value)
                 out.steps[i, j, k] = step
 
                 def record(it, P, i=i, j=j, k=k):
                     if it in where:
-                        for name, v in C.evaluate(P, hausdorff=False).items():
+                        for name, v in comparison.evaluate(P, hausdorff=False).items():
                             out.values[name][i, j, k, where[it]] = v
 
                 with warnings.catch_warnings():
@@ -462,7 +463,8 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     for method, weights in grids:
         check_choice("method", method, METHODS + ("taubin",))
         check_choice("weights", weights, WEIGHTS)
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    if comparison is None:
+        comparison = MeshComparison(V_clean, F)
     out = DenoisingComparison(sigmas, grids)
     for steps, counts in out.grids.values():
         if not steps or not counts or min(counts) < 1 or min(steps) <= 0:
@@ -473,7 +475,7 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
 
     def sweep(indices, bar):
         for i, j in (jobs[x] for x in indices):
-            _compare(C, out, i, j, seed)
+            _compare(comparison, out, i, j, seed)
 
     def rows(indices):
         found = {}
@@ -497,21 +499,21 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     return out
 
 
-def _compare(C, out, i, j, seed):
+def _compare(comparison, out, i, j, seed):
     """The runs of :func:`denoising_comparison` of method ``j`` at noise level ``i``, recorded into ``out``."""
-    W = add_noise(C.V_clean, C.F, out.sigmas[i], seed)
-    for key, value in C.evaluate(W, hausdorff=False).items():
+    W = add_noise(comparison.V_clean, comparison.F, out.sigmas[i], seed)
+    for key, value in comparison.evaluate(W, hausdorff=False).items():
         if key in out.noisy:
             out.noisy[key][i] = value
     (method, weights), (steps, counts) = out.methods[j], out.grids[out.methods[j]]
-    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, C.F, weights)
-    out.limits[i, j] = limit = explicit_step_limit(W, C.F, weights)
+    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, comparison.F, weights)
+    out.limits[i, j] = limit = explicit_step_limit(W, comparison.F, weights)
     where = {k: l for l, k in enumerate(counts)}
     for k, fraction in enumerate(steps):
 
         def record(it, P, k=k):
             if it in where:
-                for key, value in C.evaluate(P, hausdorff=False).items():
+                for key, value in comparison.evaluate(P, hausdorff=False).items():
                     if key in out.values:
                         out.values[key][j][i, k, where[it]] = value
 
