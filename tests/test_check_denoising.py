@@ -1,7 +1,5 @@
 """The exercise checks of notebook 07: they accept the reference, and name each typical mistake."""
 
-import time
-
 import numpy as np
 import pytest
 from diagnoses import assert_diagnosed
@@ -115,12 +113,10 @@ WRONG_RMS = {
 }
 
 
-def test_reference_noise_passes_quickly():
-    start = time.perf_counter()
+def test_reference_noise_passes():
     result = check.add_noise(noise_reference)
     assert result.passed, result.message
     assert "grid" in result.message
-    assert time.perf_counter() - start < 1.0
 
 
 def test_rng_normal_with_a_scale_passes_too():

@@ -78,3 +78,16 @@ def test_06_every_position_of_the_sliders_shows_the_part_in_frame():
     shrunk = [r for r in rows if r["step"] == top and r["n"] == 50 and not r["keep"]]
     assert shrunk and all("x larger" in r["title"] for r in shrunk)
     assert any(r["pixels"] < 0.8 * found["input"] and "drawn" not in r["title"] for r in rows)
+
+
+def test_07_says_the_assignments_noise_tangles_the_mesh_and_shows_a_level_that_does_not():
+    run = ran("07_denoising_evaluation.ipynb")
+    text = run.outputs_text()
+    # sigma = 0.05 of the diagonal is 2.29 mean edges on the sphere: the noisy faces point almost anywhere
+    assert "moves each coordinate by 2.29 mean edge" in text and "the noisy mesh is tangled" in text
+    assert "its face normals are 87.9° off the clean ones" in text
+    assert "At $\\sigma$ = 0.005 (0.23 mean edges) they are 25.2° off: a surface, the second row." in text
+    cell = next(c for c in run.notebook.cells if c.get("id") == "nb07-008")
+    alts = [out["metadata"]["image/png"]["alt"] for out in cell.outputs if "image/png" in out.get("data", {})]
+    assert len(alts) == 2 and "3D view of noisy, sigma 0.005" in alts[1]
+    assert not run.notes, run.notes

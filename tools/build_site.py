@@ -79,6 +79,7 @@ NOTEBOOK_GLOBS = ("[0-9][0-9]_*.ipynb", "[0-9][0-9]a_*.ipynb")
 DOC_PAGES = {
     "README.md": "about.html",
     "docs/README.md": "docs.html",
+    "docs/assignment.md": "assignment.html",
     "docs/install.md": "install.html",
     "docs/grading.md": "grading.html",
     "docs/experiments.md": "experiments.html",
