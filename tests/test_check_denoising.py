@@ -1,6 +1,5 @@
 """The exercise checks of notebook 07: they accept the reference, and name each typical mistake."""
 
-
 import numpy as np
 import pytest
 from diagnoses import assert_diagnosed

@@ -88,5 +88,18 @@ def test_07_says_the_assignments_noise_tangles_the_mesh_and_shows_a_level_that_d
     assert "At $\\sigma$ = 0.005 (0.23 mean edges) they are 25.2° off: a surface, the second row." in text
     cell = next(c for c in run.notebook.cells if c.get("id") == "nb07-008")
     alts = [out["metadata"]["image/png"]["alt"] for out in cell.outputs if "image/png" in out.get("data", {})]
-    assert len(alts) == 2 and "3D view of noisy, sigma 0.005" in alts[1]
+    assert len(alts) == 2 and "3D view of noisy, sigma 0.005" in alts[1] and "Faces 25.2 degrees off" in alts[1]
     assert not run.notes, run.notes
+
+
+def test_01_the_flat_plane_is_white_over_its_colour_bar():
+    run = ran("01_uniform_laplace_curvature.ipynb")
+    for cell_id in ("08d83201", "0f1b474c"):  # the rows of uniform H and of K: the plane left
+        still, alt = _still(run, cell_id)
+        plane = still[:, :380]
+        render = plane[18 : 18 + 340]
+        drawn = render[np.any(render < 250, axis=2) & ~_coloured(render)]  # the surface but its violet NaN rim
+        assert np.median(drawn) > 220, cell_id  # white, as the text calls zero (a light at the eye drew it 156)
+        bar = plane[18 + 340 + 6 + 5, 60:-60].astype(int)  # the colour bar's middle row
+        assert bar[:, 2].max() - bar[:, 0].min() > 100, cell_id  # drawn: blue to red, 0 white between
+        assert "0 everywhere" in alt
