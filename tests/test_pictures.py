@@ -45,17 +45,18 @@ def test_05_the_top_eigenvector_is_seen_where_it_lives():
 MEASURE_06 = """
 import json
 rows = []
+slider_steps, value, view, top_count = knobs.positions, knobs.value, knobs.view, knobs.controls["iterations"].max
 chosen = [slider_steps[0], value, slider_steps[-1]]
-runs = [(s, n, keep, "fixed") for s in slider_steps for n in (1, ITERATIONS, iter_slider.max) for keep in (False, True)]
-runs += [(s, iter_slider.max, keep, "rebuilt") for s in chosen for keep in (False, True)]
+runs = [(s, n, keep, "fixed") for s in slider_steps for n in (1, ITERATIONS, top_count) for keep in (False, True)]
+runs += [(s, top_count, keep, "rebuilt") for s in chosen for keep in (False, True)]
 for s, n, keep, op in runs:
-    update(s, n, keep, op)
+    knobs.update(s, n, keep, op)
     picture = view.still()[18 : 18 + view.height] if view.title else view.still()[: view.height]
     ink = (picture < 245).any(axis=2)
     rows.append(dict(step=float(s), n=n, keep=keep, op=op, pixels=int(ink.sum()),
                      border=int(ink[0].sum() + ink[-1].sum() + ink[:, 0].sum() + ink[:, -1].sum()),
                      title=view._title.value))
-update(value, 0, False, "fixed")
+knobs.update(value, 0, False, "fixed")
 input_pixels = int((view.still()[18 : 18 + view.height] < 245).any(axis=2).sum())
 print(json.dumps(dict(rows=rows, input=input_pixels, top=float(slider_steps[-1] / value))))
 """
