@@ -33,6 +33,7 @@ SHORTCUTS = {
     "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
         V, F, sigma, tau, iterations, seed
     )[0],
+    "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
     "normal_curvature": lambda a, b, c, phi: symbolic.ellipsoid_normal_curvature(a, b, c, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
 }
