@@ -171,12 +171,13 @@ def open_folder(solutions, work, env):
 
 
 def test_workers(args):
-    """pytest-xdist options for the test command: one worker per core, each notebook file
-    kept whole on one worker (nbval runs a notebook's cells in order in one kernel), unless
-    the arguments choose the workers themselves (``-n 0`` runs everything in one process)."""
+    """pytest-xdist options for the test command: one worker per core, unless the arguments
+    choose the workers themselves (``-n 0`` runs everything in one process). Each notebook
+    file stays whole on one worker (nbval runs a notebook's cells in order in one kernel):
+    pyproject.toml's ``--dist loadfile`` sees to that for every pytest run."""
     if any(a == "-n" or a.startswith(("-n", "--numprocesses")) or "xdist" in a for a in args):
         return []
-    return ["-n", "auto", "--dist", "loadfile"]
+    return ["-n", "auto"]
 
 
 def main(argv):

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from diagnoses import assert_diagnosed, replaying
 
+from geomlib import check
 from geomlib.lessons.laplace import barycentric_areas
 from geomlib.teaching.check.catalogue import (
     Case,
@@ -21,7 +22,7 @@ from geomlib.teaching.check.catalogue import (
     vector,
 )
 from geomlib.teaching.check.meshes import grid_3x3, irregular_tetrahedron
-from geomlib.teaching.check.result import Mistake, case_rng, exercise
+from geomlib.teaching.check.result import Mistake, call, case_rng, exercise
 
 # ---------------------------------------------------------------- the module docstring's example, as written there
 AREA_MISTAKES = [
@@ -165,7 +166,6 @@ def test_an_input_changed_in_place_is_named_by_the_learners_own_parameter_name()
 
 
 def test_a_smoothing_loop_that_overwrites_the_callers_V_is_named():
-    from geomlib import check
     from geomlib.lessons.laplace import laplacian
 
     def overwrites(V, F, tau, iterations):
@@ -179,3 +179,28 @@ def test_a_smoothing_loop_that_overwrites_the_callers_V_is_named():
         return V
 
     assert_diagnosed(check.smoothing_loop(overwrites), "the function changed its input V in place")
+
+
+# ---------------------------------------------------------------- every check: a wrong type earns nothing, and never a crash
+EXERCISES = sorted(name for name in dir(check) if hasattr(getattr(check, name), "partial_credit"))
+
+
+@pytest.mark.parametrize("name", EXERCISES)
+def test_an_answer_of_the_wrong_type_earns_nothing_in_every_check(name):
+    for returned in (None, "text", (np.zeros(2),), object()):
+        result = getattr(check, name).evaluate(lambda *args, returned=returned: returned)
+        assert not result.passed and not result.partial, (name, returned, result.message)
+
+
+@exercise("a number", reread="section 0")
+def a_number(fn):
+    if float(call(fn)) != 2.0:  # float() of what came back may raise: the check must not
+        raise Mistake("not two", typical=False)
+    return ["two"]
+
+
+def test_an_answer_the_check_cannot_read_is_a_failed_check_without_points():
+    result = a_number.evaluate(lambda: "two")
+    assert_diagnosed(result, "could not be read as an answer (ValueError", "Reread section 0")
+    assert not result.partial and result.written
+    assert a_number.evaluate(lambda: 2).passed

@@ -237,6 +237,14 @@ def smoothing_operator(V, F, weights, area, boundary_condition, operator=None):
     return V, F, LaplaceOperator.of(V, F, weights, area, boundary_condition, operator)
 
 
+def _done(k, P, callback, bar):
+    """Iteration k of a smoothing run is done with the positions P: tell ``callback`` and the progress bar."""
+    if callback is not None:
+        callback(k, P)
+    bar.step(k)
+    return P
+
+
 def _fail(on_failure, message, k, P_last, stacklevel=3):
     """Raise MeshError or warn (naming the frame ``stacklevel`` up) and return the last valid positions."""
     if on_failure == "raise":
@@ -254,21 +262,11 @@ def _fail(on_failure, message, k, P_last, stacklevel=3):
 
 
 def explicit_smoothing(
-    V,
-    F,
-    tau=None,
-    iterations=1,
-    weights="cotan",
-    *,
-    step=None,
-    step_fraction=None,
-    area="barycentric",
-    boundary_condition="fixed",
-    operator=None,
-    progress=None,
-    callback=None,
-    on_failure="raise",
-):
+    V, F, tau=None, iterations=1, weights="cotan", *,
+    step=None, step_fraction=None,  # the step, in another name or unit
+    area="barycentric", boundary_condition="fixed", operator=None,  # the operator
+    progress=None, callback=None, on_failure="raise",  # the run
+):  # fmt: skip
     """Explicit Laplacian smoothing: ``P <- P + tau M^-1 C P``, repeated ``iterations`` times.
 
     Forward Euler on the heat flow ``dP/dt = Delta P`` with ``Delta = M^-1 C``
@@ -377,10 +375,7 @@ class ExplicitSmoother:
                         f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals"
                     )
                     return _fail(on_failure, message, k, P, stacklevel=4)
-                P = P_next
-                if callback is not None:
-                    callback(k, P)
-                bar.step(k)
+                P = _done(k, P_next, callback, bar)
         finally:
             bar.close()
         return P
@@ -580,23 +575,11 @@ def _rebuilt_step(P, F, weights, area, boundary_condition, tau, k):
 
 
 def implicit_smoothing(
-    V,
-    F,
-    tau=None,
-    iterations=1,
-    weights="cotan",
-    *,
-    step=None,
-    area="barycentric",
-    boundary_condition="fixed",
-    operator=None,
-    rebuild=False,
-    keep_volume=False,
-    solver="cholesky",
-    progress=None,
-    callback=None,
-    on_failure="raise",
-):
+    V, F, tau=None, iterations=1, weights="cotan", *,
+    step=None,  # the step in another name
+    area="barycentric", boundary_condition="fixed", operator=None, rebuild=False,  # the operator
+    keep_volume=False, solver="cholesky", progress=None, callback=None, on_failure="raise",  # the run
+):  # fmt: skip
     """Implicit Laplacian smoothing: solve ``(M - tau C) P' = M P``, repeated.
 
     Backward Euler on ``dP/dt = Delta P``, ``Delta = M^-1 C`` (C symmetric
@@ -650,15 +633,9 @@ def implicit_smoothing(
         non-finite result: raise MeshError (with ``.V``, the last valid
         positions, and ``.iteration``) or warn (MeshWarning) and return them.
 
-    Returns
-    -------
-    (n, 3) float64
-
-    Raises
-    ------
-    MeshError
-        Bad tau, iterations or option; vertices with zero area; keep_volume
-        on an open mesh; a failure (above) with ``on_failure="raise"``.
+    Returns the new positions, (n, 3) float64. Raises MeshError for a bad tau, iterations or
+    option, vertices with zero area, keep_volume on an open mesh, or a failure (above) with
+    ``on_failure="raise"``.
     """
     tau, iterations = _check_tau(_tau_or_step(tau, step)), _check_iterations(iterations)
     check_choice("solver", solver, SOLVERS)
@@ -694,10 +671,7 @@ def implicit_smoothing(
                     k,
                     P,
                 )
-            P = P_next
-            if callback is not None:
-                callback(k, P)
-            bar.step(k)
+            P = _done(k, P_next, callback, bar)
     finally:
         bar.close()
     return P

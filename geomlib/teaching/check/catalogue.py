@@ -51,6 +51,15 @@ The matcher (:func:`first_mistake`; :func:`judge` raises what it finds):
 in catalogue order, so put the specific before the general. ``typical=False`` marks a
 diagnosis that only says *that* something is wrong: no partial credit.
 
+Patterns: an answer with a free part (an eigenvector's sign, the basis of a repeated
+eigenspace) is compared by what defines it, with ``same=`` (a function of answer, expected,
+case); a mistake seen in a property rather than a value is a ``when`` (eigenvalues right but
+unsorted: ``when=lambda lam, right, c: not (np.diff(lam) >= 0).all() and agree(np.sort(lam), right)``;
+one normal draw shared by x, y and z: ``when=lambda X, right, c: np.allclose(*(X - c.V).T[:2])``);
+inputs beyond the mesh (tau, k, sigma, a seed) are inputs of the ``Case``, in the order the
+learner's function takes them; a check that calls the function twice (another seed, another
+count) runs two lists of cases. Several catalogues may be judged in turn (C before M).
+
 Coercion helpers (:func:`matrix_pair`, :func:`vector`, :func:`positions`,
 :func:`eigenpairs`, :func:`number`) turn what the learner returned into float arrays or
 raise a ``Mistake``; a wrong shape or type is never partial credit (``typical=False``),

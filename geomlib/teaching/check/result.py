@@ -392,6 +392,12 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
                 return CheckResult(name, False, message + _seed_said(), partial=m.typical)
+            except Exception as exc:  # what came back could not be read as an answer: no points, never a crash
+                message = (
+                    f"what the function returned could not be read as an answer ({type(exc).__name__}: {exc}). "
+                    f"Hint: return what the exercise asks for, of the shape it states. Reread {reread}."
+                )
+                return CheckResult(name, False, message + _seed_said(), partial=False)
             finally:
                 _RULES[0] = None
             return CheckResult(name, True, "checked on " + ", ".join(checked) + "." + _seed_said())

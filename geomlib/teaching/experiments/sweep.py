@@ -178,19 +178,11 @@ class SmoothingSweep:
 
 
 def smoothing_sweep(
-    V_clean,
-    F,
-    sigmas,
-    seed,
-    schemes=SCHEMES,
-    explicit_fractions=EXPLICIT_FRACTIONS,
-    implicit_steps=IMPLICIT_STEPS,
-    iterations=SWEEP_ITERATIONS,
-    direction="isotropic",
-    comparison=None,
-    progress=True,
-    workers=None,
-):
+    V_clean, F, sigmas, seed,  # the mesh and its noise
+    schemes=SCHEMES, explicit_fractions=EXPLICIT_FRACTIONS, implicit_steps=IMPLICIT_STEPS,  # the grid
+    iterations=SWEEP_ITERATIONS, direction="isotropic",
+    comparison=None, progress=True, workers=None,  # the run
+):  # fmt: skip
     """Add noise at each level, smooth it with every scheme, step and iteration count, measure.
 
     For every noise level ``sigma`` (a fraction of the bounding-box
