@@ -1,7 +1,8 @@
 """The layer rule of geomlib (docs/developing.md, "Architecture: four layers"), held by reading every module's imports.
 
 mesh (the core) imports no other layer; numerics imports the mesh core; lessons import the
-mesh core and numerics; teaching aids may import anything. No module imports a private name
+mesh core and numerics; teaching aids import those three; course (the lecturer's class tools)
+may import anything, and nothing imports it, not even a notebook. No module imports a private name
 of another, and no two modules import each other in a circle.
 """
 
@@ -16,6 +17,8 @@ ALLOWED = {
     "numerics": {"mesh", "numerics"},
     "lessons": {"mesh", "numerics", "lessons"},
     "teaching": {"mesh", "numerics", "lessons", "teaching"},
+    # a lecturer's class tools (geomlib-course): above the teaching aids, imported by nothing
+    "course": {"mesh", "numerics", "lessons", "teaching", "course"},
 }
 
 
@@ -79,6 +82,21 @@ def test_layer_rule(path):
 def test_no_private_names_across_modules(path):
     private = sorted(f"{t}.{n}" for t, n in imports(path) if n and n.startswith("_") and n != "__version__")
     assert private == [], f"{module_name(path)} imports private names {private}"
+
+
+def test_nothing_imports_the_course_layer():
+    """geomlib.course needs the course extra (nbgrader, copydetect): the package and the notebooks
+    work without it."""
+    users = sorted(
+        module_name(p)
+        for p in MODULES
+        if layer(module_name(p)) != "course" and any(layer(t) == "course" for t, _ in imports(p))
+    )
+    assert users == [], f"modules importing geomlib.course: {users}"
+    notebooks = sorted(
+        p.name for p in (PACKAGE.parent / "notebooks").glob("*.ipynb") if "geomlib.course" in p.read_text()
+    )
+    assert notebooks == [], f"notebooks importing geomlib.course: {notebooks}"
 
 
 def test_no_import_cycles():

@@ -1,0 +1,97 @@
+"""Submissions that look copied: near-identical pairs of students, and copies of the answer.
+
+Each exercise's code, as each student wrote it in the exercise's solution cell, is compared
+by copydetect (a maintained winnowing detector in the manner of MOSS: it tokenises the code,
+so renamed variables, comments and spacing do not hide a copy) against every other
+student's and against two references: the solution notebook's answer (the course's
+``source/`` version) and geomlib's own routine for the exercise. The released stub is
+boilerplate: what every student was handed matches nobody. A student who left the stub
+is compared with no one.
+
+A pair is flagged when each of the two files is at least :data:`NEAR_IDENTICAL` covered by
+the other; a copy of a reference likewise.
+"""
+
+import importlib
+import inspect
+import re
+import tempfile
+from pathlib import Path
+
+#: share of each file's tokens found in the other above which two answers are flagged
+NEAR_IDENTICAL = 0.9
+#: copydetect's noise threshold (characters of tokenised code): matches shorter than this are ignored
+NOISE = 30
+
+
+def _normalised(source):
+    return re.sub(r"\s+", " ", source).strip()
+
+
+def geomlib_source(check_fn):
+    """The source of geomlib's own routines of an exercise (``check.NAME.own``), joined; "" if none."""
+    parts = []
+    for dotted in getattr(check_fn, "own", ()):
+        module, _, name = dotted.rpartition(".")
+        try:
+            parts.append(inspect.getsource(getattr(importlib.import_module(f"geomlib.{module}"), name)))
+        except (ImportError, AttributeError, OSError, TypeError):
+            continue
+    return "\n\n".join(parts)
+
+
+def similar_answers(answers, references, stub):
+    """Flags of one exercise.
+
+    ``answers``: {student: code}; ``references``: {label: code} (the solution notebook's,
+    geomlib's); ``stub``: the released cell. Returns a list of (student, flag, detail):
+    ``(student, "copy of LABEL", "97% of the code shared")`` and
+    ``(student, "near-identical pair", "with OTHER: 95% of the code shared")`` (once for each
+    student of a pair).
+    """
+    from copydetect import CopyDetector
+
+    written = {s: code for s, code in answers.items() if _normalised(code) != _normalised(stub)}
+    if not written:
+        return []
+    with tempfile.TemporaryDirectory(prefix="geomlib-similarity-") as scratch:
+        scratch = Path(scratch)
+        for folder in ("students", "references", "stub"):
+            (scratch / folder).mkdir()
+        (scratch / "stub" / "stub.py").write_text(stub)
+        files = {}
+        for k, (student, code) in enumerate(sorted(written.items())):
+            path = scratch / "students" / f"s{k}.py"
+            path.write_text(code)
+            files[str(path)] = ("student", student)
+        for k, (label, code) in enumerate(sorted(references.items())):
+            if code.strip():
+                path = scratch / "references" / f"r{k}.py"
+                path.write_text(code)
+                files[str(path)] = ("reference", label)
+        detector = CopyDetector(
+            test_dirs=[str(scratch / "students")],
+            ref_dirs=[str(scratch / "students"), str(scratch / "references")],
+            boilerplate_dirs=[str(scratch / "stub")],
+            extensions=["py"],
+            noise_t=NOISE,
+            guarantee_t=NOISE,
+            display_t=0.0,
+            autoopen=False,
+            silent=True,
+        )
+        detector.run()
+        flags = []
+        for i, test in enumerate(detector.test_files):
+            for j, ref in enumerate(detector.ref_files):
+                mine, theirs = detector.similarity_matrix[i, j]
+                if test == ref or min(mine, theirs) < NEAR_IDENTICAL:
+                    continue
+                _, student = files[test]
+                kind, other = files[ref]
+                share = round(float(min(mine, theirs)), 3)
+                if kind == "reference":
+                    flags.append((student, f"copy of {other}", f"{share:.0%} of the code shared"))
+                else:
+                    flags.append((student, "near-identical pair", f"with {other}: {share:.0%} of the code shared"))
+        return sorted(set(flags))
