@@ -67,10 +67,16 @@ COMMANDS = [
     (r"nbgrader (generate_assignment|autograde|export|generate_feedback|validate)\b", "tests/test_nbgrader.py"),
     (r"nbgrader (quickstart|release_assignment|collect|release_feedback|fetch_assignment|submit|fetch_feedback)\b", "here"),
     (r"cd geomlib-course$", "here"),
-    (r"rm -r source/ps1$", "here"),
+    (r"rm -r source/ps1 source/header\.ipynb$", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
     (r"mkdir -p source/curvature$", "here"),
-    (r"cp \.\./notebooks/", "here"),
-    (r"cat >> nbgrader_config\.py$", "here"),
+    (r"cp \.\./notebooks/0\[1-7\]", "here"),
+    (r"cat >> nbgrader_config\.py$", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
+    (r"geomlib-course autograde \. \w+ --workers \d+$", "tests/test_course.py::test_progress_shows_each_student_with_the_count_seconds_and_time_left"),
+    (r"geomlib-course report \. \w+$", "tests/test_course.py::test_the_class_report_counts_every_outcome_exactly"),
+    # the guide's one-machine trial, run as a script by the test (the students' configuration too)
+    (r"(mkdir -p (source/trial|\.\./alice|~/\.jupyter)|cd \.\./(alice|bob|geomlib-course)|cd \.\.$|cd bob$)", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
+    (r"(cp \.\./notebooks/01_|cp -r alice bob$|rm -r \.cache trial$|sed -i s/alice/bob/ )", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
+    (r"cat > (nbgrader_config\.py|~/\.jupyter/nbgrader_config\.py)$", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
 ]
 # fmt: on
 
@@ -322,3 +328,24 @@ def test_the_readme_names_every_exercise_in_its_notebooks_row():
             if cell.metadata.get("nbgrader", {}).get("solution") and grade_id in exercises:
                 graded[grade_id] = path.name
     assert named == graded
+
+
+def test_the_syllabus_gives_each_notebook_its_time_exercises_and_discuss_points():
+    """docs/syllabus.md's table: the minutes each notebook's opening block states, the exercises its
+    solution cells hold and the points of its Discuss answers; the totals its text gives."""
+    import build_assignment
+
+    text = (ROOT / "docs" / "syllabus.md").read_text()
+    rows = re.findall(r"^\| \[(\d\d)\]\(\.\./notebooks/([^)]+)\) \|[^|]*\| ([^|]*) \| ([^|]*) \| (\d+) \|$", text, re.M)
+    assert [n for n, *_ in rows] == [f"{i:02d}" for i in range(8)]
+    auto = hand = minutes = 0
+    for _, name, exercises, discuss, stated in rows:
+        nb = nbformat.read(ROOT / "notebooks" / name, as_version=4)
+        assert int(stated) == _stated_minutes(ROOT / "notebooks" / name), name
+        points = build_assignment.exercise_points(nb)
+        assert re.findall(r"`(\w+)`", exercises) == list(points), name
+        by_hand = sum(build_assignment.discussion_points(nb).values())
+        assert discuss.strip() == (f"{by_hand} points" if by_hand else "none"), name
+        auto, hand, minutes = auto + sum(points.values()), hand + by_hand, minutes + int(stated)
+    assert f"{minutes} minutes" in text
+    assert f"worth {auto + hand} points: {auto} auto-graded, {hand} by hand" in text

@@ -8,14 +8,17 @@ student's and against two references: the solution notebook's answer (the course
 boilerplate: what every student was handed matches nobody. A student who left the stub
 is compared with no one.
 
-A pair is flagged when each of the two files is at least :data:`NEAR_IDENTICAL` covered by
-the other; a copy of a reference likewise.
+A pair is flagged when each of the two answers is at least :data:`NEAR_IDENTICAL` covered by
+the other; a copy when the answer is that much covered by a reference (geomlib's routine
+carries a docstring and checks the student's copy leaves out).
 """
 
+import ast
 import importlib
 import inspect
 import re
 import tempfile
+import textwrap
 from pathlib import Path
 
 #: share of each file's tokens found in the other above which two answers are flagged
@@ -28,16 +31,40 @@ def _normalised(source):
     return re.sub(r"\s+", " ", source).strip()
 
 
+def _without_docstrings(source):
+    """A function's source with its docstrings' lines left out (what a student would copy)."""
+    source = textwrap.dedent(source)
+    drop = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and ast.get_docstring(node) is not None:
+            drop.update(range(node.body[0].lineno, node.body[0].end_lineno + 1))
+    return "\n".join(line for k, line in enumerate(source.splitlines(), 1) if k not in drop)
+
+
 def geomlib_source(check_fn):
-    """The source of geomlib's own routines of an exercise (``check.NAME.own``), joined; "" if none."""
+    """The code of geomlib's own routines of an exercise (``check.NAME.own``), docstrings left
+    out, joined; "" if none."""
     parts = []
     for dotted in getattr(check_fn, "own", ()):
         module, _, name = dotted.rpartition(".")
         try:
-            parts.append(inspect.getsource(getattr(importlib.import_module(f"geomlib.{module}"), name)))
+            parts.append(
+                _without_docstrings(inspect.getsource(getattr(importlib.import_module(f"geomlib.{module}"), name)))
+            )
         except (ImportError, AttributeError, OSError, TypeError):
             continue
     return "\n\n".join(parts)
+
+
+def own_lines(code, stub):
+    """The lines of an answer that are its own: not lines of the released stub (the def line,
+    the docstring), nor imports (whose module paths would weigh as much as the code)."""
+    handed = {line.strip() for line in stub.splitlines() if line.strip()}
+    return "\n".join(
+        line
+        for line in code.splitlines()
+        if line.strip() not in handed and not re.match(r"\s*(import|from)\s+\S+", line)
+    )
 
 
 def similar_answers(answers, references, stub):
@@ -62,12 +89,12 @@ def similar_answers(answers, references, stub):
         files = {}
         for k, (student, code) in enumerate(sorted(written.items())):
             path = scratch / "students" / f"s{k}.py"
-            path.write_text(code)
+            path.write_text(own_lines(code, stub))
             files[str(path)] = ("student", student)
         for k, (label, code) in enumerate(sorted(references.items())):
             if code.strip():
                 path = scratch / "references" / f"r{k}.py"
-                path.write_text(code)
+                path.write_text(own_lines(code, stub))
                 files[str(path)] = ("reference", label)
         detector = CopyDetector(
             test_dirs=[str(scratch / "students")],
@@ -85,11 +112,13 @@ def similar_answers(answers, references, stub):
         for i, test in enumerate(detector.test_files):
             for j, ref in enumerate(detector.ref_files):
                 mine, theirs = detector.similarity_matrix[i, j]
-                if test == ref or min(mine, theirs) < NEAR_IDENTICAL:
-                    continue
                 _, student = files[test]
                 kind, other = files[ref]
-                share = round(float(min(mine, theirs)), 3)
+                # a copy of a reference: the student's code is the reference's (however much of the
+                # reference's file it takes); a pair: each of the two is the other's
+                share = float(mine if kind == "reference" else min(mine, theirs))
+                if test == ref or share < NEAR_IDENTICAL:
+                    continue
                 if kind == "reference":
                     flags.append((student, f"copy of {other}", f"{share:.0%} of the code shared"))
                 else:
