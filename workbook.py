@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Set up and run the workbook: the two commands of the README.
 
-    python3 workbook.py lab        # JupyterLab on notebooks/, opened at notebook 00
+    python3 workbook.py lab        # JupyterLab on your own copy of the exercises (my-work/), at notebook 00
+    python3 workbook.py lab --solutions   # the solution version instead (a banner on each notebook says so)
     python3 workbook.py notebook   # the same in Jupyter Notebook 7 instead of JupyterLab
     python3 workbook.py test       # every test: unit, notebooks (nbval), browser
     python3 workbook.py assignment # the assignment version in build/assignment/
@@ -16,6 +17,15 @@ Needs only Python 3.11 or newer with its standard ``venv`` module.
 Extra arguments after ``test`` go to pytest, after ``lab`` to JupyterLab,
 after ``notebook`` to Jupyter Notebook; ``run`` takes a notebook and NAME=VALUE
 pairs (tools/run_notebook.py says more).
+
+``lab`` and ``notebook`` open the exercise version (stubs where the solutions
+are, empty answer boxes; built as ``assignment`` builds it) in a working folder
+of the reader's own, ``my-work/`` beside ``notebooks/`` (``--work DIR`` for
+another; git ignores my-work/). A notebook already there is the reader's and
+is never overwritten, whatever the workbook's update brought; a notebook the
+folder lacks is added. ``--solutions`` opens the solution version instead,
+rewritten into ``build/solutions/`` on every run, each notebook opening with a
+banner that says what it is.
 """
 
 import hashlib
@@ -29,6 +39,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent
 NOTEBOOKS = ROOT / "notebooks"
 FIRST_NOTEBOOK = "00_getting_started.ipynb"
+WORK = ROOT / "my-work"  # the reader's own copies of the exercise version (kept across runs and updates)
+EXERCISES = ROOT / "build" / "exercises"  # the exercise version as this checkout builds it
+SOLUTIONS = ROOT / "build" / "solutions"  # the solution version with its banner
 VENV = ROOT / ".venv"
 BIN = VENV / ("Scripts" if os.name == "nt" else "bin")
 PY = BIN / ("python.exe" if os.name == "nt" else "python")
@@ -76,8 +89,8 @@ def ensure_environment():
         STAMP.write_text(fingerprint)
 
 
-def front_end_command(app, args, root=False):
-    """The command line that opens notebooks/ in ``app`` ("lab" or "notebook").
+def front_end_command(app, args, root=False, folder=NOTEBOOKS):
+    """The command line that opens ``folder`` in ``app`` ("lab" or "notebook").
 
     The browser opens at notebook 00 (the app's default URL), so a newcomer
     lands on the first lesson; ``args`` go to the app unchanged.
@@ -88,7 +101,7 @@ def front_end_command(app, args, root=False):
         BIN / "jupyter",
         app,
         "--notebook-dir",
-        NOTEBOOKS,
+        folder,
         f"--{app_class}.default_url={first}{FIRST_NOTEBOOK}",
         *args,
     ]
@@ -97,13 +110,74 @@ def front_end_command(app, args, root=False):
     return [str(c) for c in cmd]
 
 
+def front_end_options(args):
+    """``(solutions, work, rest)`` from the arguments of ``lab``/``notebook``: the ``--solutions`` flag,
+    the working folder (``--work DIR``, else my-work/) and the arguments left for the app."""
+    solutions, work, rest = False, WORK, []
+    args = list(args)
+    while args:
+        a = args.pop(0)
+        if a == "--solutions":
+            solutions = True
+        elif a == "--work" and args:
+            work = Path(args.pop(0)).expanduser().resolve()
+        elif a.startswith("--work="):
+            work = Path(a.split("=", 1)[1]).expanduser().resolve()
+        else:
+            rest.append(a)
+    return solutions, work, rest
+
+
+def add_missing_notebooks(built, work):
+    """Copy into ``work`` each notebook of ``built`` that ``work`` lacks; leave the others alone.
+
+    Returns ``(added, kept)``, the names copied and the names already there (the reader's:
+    never overwritten, so an update of the workbook cannot erase an attempt).
+    """
+    work.mkdir(parents=True, exist_ok=True)
+    added, kept = [], []
+    for path in sorted(built.glob("*.ipynb")):
+        target = work / path.name
+        if target.exists():
+            kept.append(path.name)
+        else:
+            target.write_bytes(path.read_bytes())
+            added.append(path.name)
+    return added, kept
+
+
+def open_folder(solutions, work, env):
+    """Build the version asked for and return the folder to open (printing what it holds)."""
+    builder = [str(PY), str(ROOT / "tools" / "build_assignment.py"), "--quiet"]
+    if solutions:
+        subprocess.run([*builder, "--solutions", "--out", str(SOLUTIONS)], check=True, cwd=ROOT, env=env)
+        print(
+            f"The SOLUTION version (every answer filled in), rewritten in {SOLUTIONS.relative_to(ROOT)}/; "
+            f"your own work stays in {work}.",
+            flush=True,
+        )
+        return SOLUTIONS
+    subprocess.run([*builder, "--out", str(EXERCISES)], check=True, cwd=ROOT, env=env)
+    added, kept = add_missing_notebooks(EXERCISES, work)
+    print(f"Your working folder: {work}", flush=True)
+    if added:
+        print(f"  added the exercise version of {len(added)} notebook(s): {', '.join(added)}", flush=True)
+    if kept:
+        print(
+            f"  kept your {len(kept)} notebook(s) already there, unchanged (delete one to start it afresh)", flush=True
+        )
+    print("  the solution version: python3 workbook.py lab --solutions", flush=True)
+    return work
+
+
 def test_workers(args):
-    """pytest-xdist options for the test command: one worker per core, each notebook file
-    kept whole on one worker (nbval runs a notebook's cells in order in one kernel), unless
-    the arguments choose the workers themselves (``-n 0`` runs everything in one process)."""
+    """pytest-xdist options for the test command: one worker per core, unless the arguments
+    choose the workers themselves (``-n 0`` runs everything in one process). Each notebook
+    file stays whole on one worker (nbval runs a notebook's cells in order in one kernel):
+    pyproject.toml's ``--dist loadfile`` sees to that for every pytest run."""
     if any(a == "-n" or a.startswith(("-n", "--numprocesses")) or "xdist" in a for a in args):
         return []
-    return ["-n", "auto", "--dist", "loadfile"]
+    return ["-n", "auto"]
 
 
 def main(argv):
@@ -124,9 +198,11 @@ def main(argv):
         # in the caller's folder: relative paths in the values are relative to it
         return subprocess.call([str(PY), str(ROOT / "tools" / "run_notebook.py"), *rest], env=env)
     if command in ("lab", "notebook"):
-        cmd = front_end_command(command, rest, root=hasattr(os, "geteuid") and os.geteuid() == 0)
+        solutions, work, rest = front_end_options(rest)
+        folder = open_folder(solutions, work, env)
+        cmd = front_end_command(command, rest, root=hasattr(os, "geteuid") and os.geteuid() == 0, folder=folder)
         print("+", " ".join(cmd), flush=True)
-        return subprocess.call(cmd, cwd=NOTEBOOKS, env=env)
+        return subprocess.call(cmd, cwd=folder, env=env)
     cmd = [PY, "-m", "pytest", *test_workers(rest), *rest]
     print("+", " ".join(str(c) for c in cmd), flush=True)
     return subprocess.call([str(c) for c in cmd], cwd=ROOT, env=env)

@@ -31,7 +31,7 @@ import trimesh
 import geomlib
 from geomlib.lessons.metrics import MeshComparison, denoising_metrics, point_surface_distance, sample_surface
 from geomlib.mesh.errors import MeshWarning
-from geomlib.teaching.sweep import (
+from geomlib.teaching.experiments.sweep import (
     EXPLICIT_FRACTIONS,
     IMPLICIT_STEPS,
     SCHEMES,

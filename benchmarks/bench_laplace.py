@@ -138,7 +138,7 @@ def main():
 
     import platform
 
-    from geomlib.teaching.surfaces import icosphere
+    from geomlib.teaching.shapes.surfaces import icosphere
 
     results = []
 

@@ -64,7 +64,7 @@ def build_meshes(folder, n):
     V, F = refined(V, F, n)
     geomlib.save_mesh(folder / "scan.obj", V, F)
     geomlib.save_mesh(folder / "scan_noisy.obj", noisy(V, F, seed=1), F)
-    grid = geomlib.teaching.surfaces.plane(n=int(np.ceil(np.sqrt(n))), size=2.0)
+    grid = geomlib.teaching.shapes.surfaces.plane(n=int(np.ceil(np.sqrt(n))), size=2.0)
     geomlib.save_mesh(folder / "plane_noisy.obj", noisy(grid.V, grid.F, seed=2), grid.F)
     shipped = len(geomlib.load_mesh(geomlib.data_path("cad_part.obj"))[0])
     make_meshes.CAD_EDGE *= np.sqrt(shipped / (1.05 * n))  # vertices grow as 1 / edge^2

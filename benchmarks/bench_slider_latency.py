@@ -49,7 +49,7 @@ import ipywidgets
 import trimesh
 import matplotlib
 import pythreejs as three
-from geomlib.teaching.viewer import MeshView
+from geomlib.teaching.display.viewer import MeshView
 
 def deform(V, t):
     """A smooth bump pattern whose amplitude is t; returns positions and the radial offset."""
@@ -168,7 +168,7 @@ def python_side(levels):
     import numpy as np
     import trimesh
 
-    from geomlib.teaching.viewer import MeshView
+    from geomlib.teaching.display.viewer import MeshView
 
     out = {}
     for level, n, _ in levels:
@@ -190,7 +190,7 @@ def still_time():
     import numpy as np
     import trimesh
 
-    from geomlib.teaching.viewer import MeshView
+    from geomlib.teaching.display.viewer import MeshView
 
     m = trimesh.creation.torus(1.0, 0.4, major_sections=128, minor_sections=100)
     view = MeshView(np.asarray(m.vertices), np.asarray(m.faces), values=np.asarray(m.vertices)[:, 2])

@@ -139,7 +139,7 @@ def slider_meshes():
 def bench_slider(repeat):
     """The callback of notebook 06's sliders on a 25k-vertex mesh, timed."""
     from geomlib import ImplicitSmoother
-    from geomlib.teaching.viewer import MeshView
+    from geomlib.teaching.display.viewer import MeshView
 
     slider = 10.0 ** np.arange(-1.0, 3.01, 0.25)  # the notebook's FloatLogSlider positions (step / h^2)
     for name, V, F in slider_meshes():

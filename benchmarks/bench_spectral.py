@@ -45,11 +45,11 @@ import scipy.sparse.linalg as sla
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import geomlib  # noqa: E402
-import geomlib.numerics.cache as basis_cache  # noqa: E402
+import geomlib.numerics.eigenbasis_store as basis_cache  # noqa: E402
 from geomlib import eigenbasis, laplacian, spectral_basis, spectral_reconstruction  # noqa: E402
 from geomlib.numerics.eigen import one_blas_thread  # noqa: E402
 from geomlib.numerics.factor import forget_factorisations  # noqa: E402
-from geomlib.teaching.surfaces import icosphere, torus  # noqa: E402
+from geomlib.teaching.shapes.surfaces import icosphere, torus  # noqa: E402
 
 CASES = [(5, 50), (5, 200), (6, 50), (6, 200), (7, 50), (7, 200)]  # (icosphere subdivisions, k)
 GOAL_RATIO, GOAL_COLD_S, GOAL_WARM_S, GOAL_SLIDER_MS = 0.5, 3.0, 1.0, 50.0

@@ -23,10 +23,12 @@ Layers (one sub-package each; ``tests/test_layers.py`` holds the rule):
 * ``geomlib.mesh``: the mesh core (errors, validation, topology, geometry, I/O);
 * ``geomlib.numerics``: numerical machinery (factorisations, eigensolvers, caches, progress);
 * ``geomlib.lessons``: the formulas the notebooks derive;
-* ``geomlib.teaching``: viewers, exercise checks, notebook helpers, experiment drivers.
+* ``geomlib.teaching``: exact shapes, experiment drivers, display, figures, exercise checks, notebook helpers;
+* ``geomlib.course``: grading a class, above the teaching aids (no notebook imports it).
 
 The mesh core imports no other layer; numerics imports only the mesh core;
-lessons import the mesh core and numerics; teaching aids may import anything.
+lessons import the mesh core and numerics; teaching aids import those three.
+Importing geomlib sets up no display: a notebook's set-up cell calls :func:`setup_display`.
 """
 
 import sys
@@ -36,7 +38,6 @@ from importlib.util import spec_from_loader
 from .mesh.errors import MeshError, MeshWarning  # noqa: F401  (public names, listed in __all__)
 
 __version__ = "0.1.0"
-import_module(".teaching.frontends", __name__).enable_colab_widgets()  # Colab draws the 3D views only after this
 
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
@@ -78,13 +79,14 @@ _EXPORTS = {
     "explicit_step_limit": "lessons.smoothing",
     "highest_frequency_mode": "lessons.smoothing",
     "mode_factor": "lessons.filters",
-    "plot_mode_factors": "lessons.filters",
+    "plot_mode_factors": "teaching.figures.filter_plots",
     "fixed_point": "lessons.smoothing",
     "ExplicitSmoother": "lessons.smoothing",
     "ImplicitSmoother": "lessons.smoothing",
     # noise and evaluation
     "add_noise": "lessons.noise",
     "denoising_experiment": "lessons.noise",
+    "denoising_sweep": "lessons.noise",
     "bounding_box_diagonal": "mesh.geometry",
     "vertex_rms": "lessons.metrics",
     "hausdorff_distance": "lessons.metrics",
@@ -98,7 +100,9 @@ _EXPORTS = {
     "denoising_metrics": "lessons.metrics",
     "MeshComparison": "lessons.metrics",
     "point_surface_distance": "lessons.metrics",
-    "smoothing_sweep": "teaching.sweep",
+    "smoothing_sweep": "teaching.experiments.sweep",
+    # the display: 3D views in Colab, still pictures where no browser draws them, the plots' colours
+    "setup_display": "teaching.display.viewer",
     # progress over the notebooks' loops over meshes
     "loop": "numerics.progress",
     "LARGE_MESH": "numerics.progress",
@@ -108,10 +112,10 @@ _EXPORTS = {
 _MODULES = {
     "symbolic": "lessons.symbolic",
     "check": "teaching.check",
-    "surfaces": "teaching.surfaces",
-    "viewer": "teaching.viewer",
+    "surfaces": "teaching.shapes.surfaces",
+    "viewer": "teaching.display.viewer",
     "metrics": "lessons.metrics",
-    "sweep": "teaching.sweep",
+    "sweep": "teaching.experiments.sweep",
 }
 
 

@@ -6,3 +6,16 @@ def assert_diagnosed(result, *phrases):
     assert not result.passed, result.message
     for phrase in phrases:
         assert phrase in result.message, result.message
+
+
+def replaying(cases, answer):
+    """A learner's function that hands back ``answer(case)`` on each of a check's cases (found by its first
+    input): a catalogue's wrong answers handed in as the check, run with the same seed, will see them."""
+    import numpy as np
+
+    table = {np.asarray(next(iter(c.inputs.values()))).tobytes(): answer(c) for c in cases}
+
+    def handed_in(*inputs):
+        return table[np.asarray(inputs[0]).tobytes()]
+
+    return handed_in

@@ -91,9 +91,15 @@ def inject(nb, parameters):
     return nb
 
 
-def run_notebook(name, timeout=600, **parameters):
-    """Execute notebooks/NAME with ``parameters`` injected; return a Run (see the module docstring)."""
+def run_notebook(name, timeout=600, after=None, **parameters):
+    """Execute notebooks/NAME with ``parameters`` injected; return a Run (see the module docstring).
+
+    ``after``: code run as one more cell at the end, in the notebook's kernel (a test's
+    measurements of the notebook's own objects); its outputs are those of the last cell.
+    """
     nb = inject(nbformat.read(NOTEBOOKS / name, as_version=4), parameters)
+    if after is not None:
+        nb.cells.append(nbformat.v4.new_code_cell(after, metadata={"tags": ["test-measurements"]}))
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp) / "notebooks"
         shutil.copytree(NOTEBOOKS, work, ignore=shutil.ignore_patterns("*.ipynb"))
@@ -113,9 +119,9 @@ def run_notebook(name, timeout=600, **parameters):
     return Run(name, parameters, seconds, nb, error, _notes(nb))
 
 
-def ran(name, **parameters):
+def ran(name, after=None, **parameters):
     """run_notebook, asserting that it ran; its time and note count are printed (``pytest -s``)."""
-    run = run_notebook(name, **parameters)
+    run = run_notebook(name, after=after, **parameters)
     run.assert_ran()
     print(f"{name} {sorted(parameters)}: {run.seconds:.1f} s, {len(run.notes)} notes")
     return run

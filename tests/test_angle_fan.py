@@ -6,8 +6,8 @@ import pytest
 
 from geomlib import MeshError
 from geomlib.lessons.curvature import angle_deficit
-from geomlib.teaching import surfaces
-from geomlib.teaching.angle_fan import angle_fan_figure, unfolded_fan
+from geomlib.teaching.figures.angle_fan import angle_fan_figure, unfolded_fan
+from geomlib.teaching.shapes import surfaces
 
 matplotlib.use("Agg")
 

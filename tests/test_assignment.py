@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 import build_assignment  # noqa: E402
 
 from geomlib import check  # noqa: E402
-from geomlib.teaching.check.result import _resolve  # noqa: E402
+from geomlib.teaching.check.fence import resolve as _resolve  # noqa: E402
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 EXERCISE_NOTEBOOKS = [p for p in NOTEBOOKS if p.name[:2] != "00" and p.name[2] == "_"]

@@ -280,7 +280,8 @@ def test_reading_order_puts_each_appendix_after_its_core(tmp_path, monkeypatch):
         "02_two.ipynb",
     ]
     pages = list(build_site.doc_pages())
-    assert pages[:3] == ["README.md", "docs/README.md", "docs/install.md"] and pages[-1] == "benchmarks/README.md"
+    assert pages[:4] == ["README.md", "docs/README.md", "docs/assignment.md", "docs/install.md"]
+    assert pages[-1] == "benchmarks/README.md"
     assert {p.relative_to(build_site.ROOT).as_posix() for p in (build_site.ROOT / "docs").glob("*.md")} <= set(pages)
 
 

@@ -1,7 +1,7 @@
 """Lesson cells a reader can take in: no code cell runs over MAX_LINES lines.
 
 Slider wiring, read-outs, arrows and markers are one named call each
-(geomlib.teaching.controls, .glyphs), so a lesson cell shows the lesson. Collapsed
+(geomlib.teaching.display.controls, .glyphs), so a lesson cell shows the lesson. Collapsed
 cells (metadata ``jupyter.source_hidden``) count too: a reader who opens one to see
 how a sentence was computed should take it in as well. Exempt:
 

@@ -1,8 +1,9 @@
-"""The shared diagnosis of vertex-area mistakes (geomlib.teaching.check.areas).
+"""The shared diagnosis of vertex-area mistakes (geomlib.teaching.check.area_mistakes).
 
-Each wrong area below is written fresh with numpy, the way a learner writes it; the diagnosis
-must name it from the areas alone, the same words whichever check asks. The meshes are the
-checks' own: every two typical mistakes must differ on the meshes a check hands in, or one
+Every wrong answer of the catalogue, handed in, gets its own diagnosis; and each wrong area
+written fresh below with numpy, the way a learner writes it (an oracle independent of the
+catalogue), is named from the areas alone, the same words whichever check asks. The meshes are
+the checks' own: every two typical mistakes must differ on the meshes a check hands in, or one
 of them could be named for the other (a tetrahedron alone cannot tell "a ninth" from "the
 mean of A_f/3": all its vertices have three triangles).
 """
@@ -13,7 +14,9 @@ import numpy as np
 import pytest
 
 from geomlib.lessons.laplace import barycentric_areas, mixed_areas
-from geomlib.teaching.check import areas, cotangent
+from geomlib.teaching.check import area_mistakes as areas
+from geomlib.teaching.check import cotangent, meshes
+from geomlib.teaching.check.catalogue import Case
 
 
 def face_areas(V, F, halve=True):
@@ -70,6 +73,13 @@ BARYCENTRIC = [
     ("cross only", "neither halved nor divided by 3"),
 ]
 MESHES = [(V, F) for _, V, F in cotangent._AREA_CASES]
+CATALOGUE = [(asked, entry) for asked, entries in areas.AREA_MISTAKES.items() for entry in entries]
+
+
+@pytest.mark.parametrize("asked, entry", CATALOGUE, ids=[f"{a}: {e.diagnosis[:40]}" for a, e in CATALOGUE])
+def test_every_wrong_area_of_the_catalogue_gets_its_own_diagnosis(asked, entry):
+    wrong = [(entry.build(Case("", V=V, F=F)), V, F) for V, F in MESHES]
+    assert areas.area_mistake_over(wrong, asked) == (entry.diagnosis, entry.hint)
 
 
 @pytest.mark.parametrize("mistake, phrase", BARYCENTRIC, ids=[m for m, _ in BARYCENTRIC])
@@ -79,10 +89,10 @@ def test_barycentric_mistakes_are_named_over_the_meshes(mistake, phrase):
 
 
 def test_the_mean_is_a_ninth_on_a_tetrahedron_alone_and_named_right_with_other_valences():
-    V, F = cotangent._TET_V, cotangent._TET_F
-    assert "a ninth" in areas.area_mistake(learner(V, F, "mean"), V, F)[0]
-    V, F = cotangent._BIPYRAMID_V, cotangent._BIPYRAMID_F
-    assert "the mean" in areas.area_mistake(learner(V, F, "mean"), V, F)[0]
+    V, F = meshes.irregular_tetrahedron()
+    assert "a ninth" in areas.area_mistake_over([(learner(V, F, "mean"), V, F)])[0]
+    V, F = meshes.irregular_bipyramid()
+    assert "the mean" in areas.area_mistake_over([(learner(V, F, "mean"), V, F)])[0]
 
 
 def test_right_areas_and_unnamed_ones_give_none():
@@ -106,29 +116,30 @@ def test_voronoi_kinds_are_named_against_what_is_asked():
 
 
 def test_a_mistake_is_named_only_where_it_differs_from_the_right_areas():
-    V, F = cotangent._TET_V, cotangent._TET_F  # no obtuse triangle: plain Voronoi areas are the mixed ones
+    V, F = meshes.irregular_tetrahedron()  # no obtuse triangle: plain Voronoi areas are the mixed ones
     assert np.allclose(learner_voronoi(V, F, obtuse_rule=False), mixed_areas(V, F))
-    assert areas.area_mistake(learner_voronoi(V, F, obtuse_rule=False), V, F, "mixed") is None
+    assert areas.area_mistake_over([(learner_voronoi(V, F, obtuse_rule=False), V, F)], "mixed") is None
 
 
 def test_where_restricts_the_comparison_and_a_rounded_pi_still_matches():
-    V, F = cotangent._GRID_V, cotangent._GRID_F
+    V, F = meshes.jittered_grid_4x4()
     A = 3 * barycentric_areas(V, F) * (1 + 3e-7)  # read back from a deficit with pi = 3.141593
     where = np.zeros(len(V), bool)
     where[[5, 6, 9, 10]] = True
     A[~where] = np.nan
-    assert "full area" in areas.area_mistake(A, V, F, where=where)[0]
+    assert "full area" in areas.area_mistake_over([(A, V, F, where)])[0]
 
 
-@pytest.mark.parametrize("asked", areas.ASKED)
+@pytest.mark.parametrize("asked", areas.AREA_MISTAKES)
 def test_every_two_mistakes_differ_on_the_meshes_of_each_check(asked):
     for cases in (cotangent._CASES, cotangent._AREA_CASES):
-        per_mesh = [areas.typical_areas(V, F, asked) for _, V, F in cases]
-        count = len(per_mesh[0][1])
+        made = [Case(label, V=V, F=F) for label, V, F in cases]
+        per_mesh = [(areas.RIGHT_AREAS[asked](c), [e.build(c) for e in areas.AREA_MISTAKES[asked]]) for c in made]
+        count = len(areas.AREA_MISTAKES[asked])
         for a, b in itertools.combinations(range(count), 2):
-            assert any(not np.allclose(vs[a][0], vs[b][0]) for _, vs in per_mesh), (asked, a, b)
+            assert any(not np.allclose(vs[a], vs[b]) for _, vs in per_mesh), (asked, a, b)
         for a in range(count):
-            assert any(not np.allclose(vs[a][0], right) for right, vs in per_mesh), (asked, a)
+            assert any(not np.allclose(vs[a], right) for right, vs in per_mesh), (asked, a)
 
 
 def test_unknown_choice_is_refused():

@@ -1,14 +1,19 @@
 """The exercise checks of notebook 07: they accept the reference, and name each typical mistake."""
 
-import time
-
 import numpy as np
 import pytest
 from diagnoses import assert_diagnosed
 
 import geomlib
 from geomlib import check
-from geomlib.mesh.geometry import bounding_box_diagonal, mean_edge_length
+
+
+def bounding_box_diagonal(V):  # the answers below are written with numpy, as the ground rules ask
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+def mean_edge_length(V, F):
+    return float(np.linalg.norm(V[F] - V[np.roll(F, 1, axis=1)], axis=2).mean())
 
 
 @pytest.fixture(autouse=True)
@@ -46,11 +51,11 @@ WRONG_NOISE = {
     ),
     "in place": (
         lambda V, F, sigma, seed: V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed)),
-        "modified in place",
+        "changed its input V in place",
     ),
     "in place, copy returned": (
         lambda V, F, sigma, seed: np.copy(V.__iadd__(sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed))),
-        "modified in place",
+        "changed its input V in place",
     ),
     "not seeded": (
         lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * np.random.standard_normal(V.shape),
@@ -108,12 +113,10 @@ WRONG_RMS = {
 }
 
 
-def test_reference_noise_passes_quickly():
-    start = time.perf_counter()
+def test_reference_noise_passes():
     result = check.add_noise(noise_reference)
     assert result.passed, result.message
     assert "grid" in result.message
-    assert time.perf_counter() - start < 1.0
 
 
 def test_rng_normal_with_a_scale_passes_too():

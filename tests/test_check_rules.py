@@ -33,7 +33,7 @@ SHORTCUTS = {
     "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
         V, F, sigma, tau, iterations, seed
     )[0],
-    "normal_curvature": lambda a, b, c, phi: symbolic.ellipsoid_normal_curvature(a, b, c, phi),
+    "normal_curvature": lambda forms, a, b, c, u, v, phi: symbolic.forms_normal_curvature(forms, a, b, c, u, v, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
 }
 

@@ -1,14 +1,19 @@
-"""The checks of notebook 01's exercises, tried with answers written fresh as learners write them (numpy and
-scipy only: the ground rules refuse geomlib's own routines): correct variants pass, each typical mistake gets
-its diagnosis, and a catch-all never hides a mistake the check can name."""
+"""The checks of notebook 01's exercises, tried two ways: every wrong answer of the checks' own catalogues,
+handed in, gets its own diagnosis; and answers written fresh as learners write them (numpy and scipy only: the
+ground rules refuse geomlib's own routines), an oracle independent of the catalogues: correct variants pass
+whatever the cases' seed, each typical mistake gets its diagnosis, and a catch-all never hides a mistake the
+check can name."""
 
 import numpy as np
 import pytest
 import scipy.sparse as sparse
-from diagnoses import assert_diagnosed
+from diagnoses import assert_diagnosed, replaying
 
 from geomlib import check
 from geomlib.teaching.check import CheckFailed
+from geomlib.teaching.check import uniform as catalogues
+
+SEEDS = (0, 1, 2, 3, 4182)
 
 
 @pytest.fixture(autouse=True)
@@ -124,10 +129,58 @@ UNIFORM_MISTAKES = {
 }
 
 
+# ---------------------------------------------------------------- the catalogues, handed in
+def built(catalogue):
+    return [entry for entry in catalogue if entry.build is not None]
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("entry", built(catalogues.C_MISTAKES), ids=repr)
+def test_every_wrong_C_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    cases = catalogues.uniform_cases(np.random.default_rng(seed))
+    result = check.uniform_laplacian(replaying(cases, lambda c: (c.M, entry.build(c))), seed=seed)
+    assert_diagnosed(result, entry.diagnosis, f"Cases seed {seed}.")
+    assert result.partial
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("entry", built(catalogues.M_MISTAKES), ids=repr)
+def test_every_wrong_M_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    cases = catalogues.uniform_cases(np.random.default_rng(seed))
+    result = check.uniform_laplacian(replaying(cases, lambda c: (entry.build(c), c.C)), seed=seed)
+    assert_diagnosed(result, entry.diagnosis)
+    assert result.partial
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_the_catalogues_right_answers_pass_and_the_seed_is_reported(seed):
+    cases = catalogues.uniform_cases(np.random.default_rng(seed))
+    result = check.uniform_laplacian(replaying(cases, lambda c: (c.M, c.C)), seed=seed)
+    assert result.passed and result.message.endswith(f"Cases seed {seed}."), result.message
+
+
+@pytest.mark.parametrize("seed", SEEDS)
 @pytest.mark.parametrize("fn", [uniform_pair, uniform_sparse, uniform_edge_loop])
-def test_uniform_accepts_correct_variants(fn):
-    result = check.uniform_laplacian(fn)
+def test_uniform_accepts_correct_variants(fn, seed):
+    result = check.uniform_laplacian(fn, seed=seed)
     assert result.passed and "tetrahedron" in result.message and "icosphere" in result.message, result.message
+
+
+def test_the_cases_vary_from_run_to_run_unless_the_seed_is_fixed(monkeypatch):
+    seen = set()
+
+    def record(V, F):
+        seen.add(V.tobytes())
+        return uniform_pair(V, F)
+
+    for _ in range(3):
+        assert check.uniform_laplacian(record).passed
+    assert len(seen) == 9  # three meshes, placed anew each run
+    seen.clear()
+    monkeypatch.setenv("GEOMLIB_CHECK_SEED", "17")
+    for _ in range(2):
+        assert check.uniform_laplacian(record).message.endswith("Cases seed 17.")
+    assert len(seen) == 3
 
 
 def test_uniform_accepts_any_vertex_order_of_the_faces():
@@ -142,7 +195,7 @@ def test_uniform_diagnoses(name):
     fn, phrase = UNIFORM_MISTAKES[name]
     result = check.uniform_laplacian(fn)
     assert_diagnosed(result, phrase, "Reread section 2")
-    named = name not in ("only C",)
+    named = name not in ("only C", "M as a vector")  # a wrong shape earns nothing (docs/grading.md)
     assert result.partial == named, result.message
 
 
@@ -257,9 +310,19 @@ K_MISTAKES = {
 }
 
 
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("entry", built(catalogues.K_MISTAKES + catalogues.K_BOUNDARY_MISTAKES), ids=repr)
+def test_every_wrong_K_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    cases = catalogues.curvature_cases(np.random.default_rng(seed))
+    result = check.gaussian_curvature(replaying(cases, entry.build), seed=seed)
+    assert_diagnosed(result, entry.diagnosis)
+    assert result.partial
+
+
+@pytest.mark.parametrize("seed", SEEDS)
 @pytest.mark.parametrize("name", K_CORRECT)
-def test_K_accepts_correct_variants(name):
-    result = check.gaussian_curvature(K_CORRECT[name])
+def test_K_accepts_correct_variants(name, seed):
+    result = check.gaussian_curvature(K_CORRECT[name], seed=seed)
     assert result.passed and "bump" in result.message and "icosphere" in result.message, result.message
 
 
@@ -273,9 +336,7 @@ def test_K_diagnoses(name):
 
 def test_the_mean_area_is_told_from_a_ninth_by_the_meshes_whose_valences_differ():
     # on the tetrahedron alone (valence 3 everywhere) the two coincide
-    from geomlib.teaching.check.uniform import _K_CASES
-
-    valences = [np.bincount(F.ravel()) for _, _, F in _K_CASES]
+    valences = [np.bincount(c.F.ravel()) for c in catalogues.curvature_cases(np.random.default_rng(0))]
     assert set(valences[0]) == {3} and any(len(set(v)) > 1 for v in valences[1:])
     result = check.gaussian_curvature(K_MISTAKES["mean of the A_f / 3"][0])
     assert "ninth" not in result.message, result.message
@@ -291,12 +352,13 @@ def test_K_catch_all_still_names_the_missing_boundary_rule():
     assert not result.partial
 
 
-def test_the_checks_meshes_hold_obtuse_triangles_and_a_boundary():
-    from geomlib.teaching.check.uniform import _K_CASES, _UNIFORM_CASES
-
-    for cases in (_K_CASES, _UNIFORM_CASES):
-        assert any((corner_angles(V, F) > np.pi / 2).any() for _, V, F in cases)
-        assert any(boundary(V, F).any() for _, V, F in cases)
+@pytest.mark.parametrize("seed", range(20))
+def test_the_checks_meshes_hold_obtuse_triangles_and_a_boundary_whatever_the_seed(seed):
+    for cases in (catalogues.curvature_cases, catalogues.uniform_cases):
+        placed = cases(np.random.default_rng(seed))
+        assert any((corner_angles(c.V, c.F) > np.pi / 2).any() for c in placed)
+        assert any(boundary(c.V, c.F).any() for c in placed)
+        assert all(np.linalg.norm(c.V, axis=1).min() > 1.0 for c in placed)  # away from the origin
 
 
 def test_K_stub_and_strict_mode(monkeypatch):

@@ -1,5 +1,5 @@
 """Tests of the notebooks' live-cell helpers: the step's unit and one step per mesh
-(geomlib.teaching.steps), sliders wired to views with a read-out (.controls), and
+(geomlib.teaching.experiments.steps), sliders wired to views with a read-out (.controls), and
 arrows and markers merged into a displayed mesh (.glyphs)."""
 
 import warnings
@@ -10,12 +10,12 @@ import pytest
 
 from geomlib import MeshError, MeshWarning
 from geomlib.mesh.geometry import enclosed_volume, mean_edge_length
-from geomlib.teaching import surfaces
-from geomlib.teaching.controls import live, mesh_warnings
-from geomlib.teaching.glyphs import Glyphs, arrow_meshes, marker_meshes
-from geomlib.teaching.steps import MeshSteps, absolute_step, log_positions, log_slider
-from geomlib.teaching.sweep import scale_free_step
-from geomlib.teaching.viewer import MeshView
+from geomlib.teaching.display.controls import live, mesh_warnings
+from geomlib.teaching.display.glyphs import Glyphs, arrow_meshes, marker_meshes
+from geomlib.teaching.display.viewer import MeshView
+from geomlib.teaching.experiments.steps import MeshSteps, absolute_step, log_positions, log_slider
+from geomlib.teaching.experiments.sweep import scale_free_step
+from geomlib.teaching.shapes import surfaces
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ import pytest
 
 from geomlib.lessons.laplace import barycentric_areas, cotangent_matrix, mixed_areas
 from geomlib.mesh.errors import MeshError
-from geomlib.teaching import cotangent_diagrams as d
-from geomlib.teaching import surfaces
+from geomlib.teaching.figures import cotangent_diagrams as d
+from geomlib.teaching.shapes import surfaces
 
 matplotlib.use("Agg")
 
@@ -72,7 +72,7 @@ def test_a_zero_area_triangle_has_no_gradient():
 
 
 def test_the_convergence_figure_shows_every_slope_once_and_says_them():
-    from geomlib.teaching.convergence import error_figure
+    from geomlib.teaching.figures.convergence import error_figure
 
     ell = [0.2, 0.1, 0.05]
     rows = {
@@ -103,7 +103,7 @@ def test_the_convergence_figure_shows_every_slope_once_and_says_them():
 
 
 def test_an_area_rule_keeps_its_marker_in_the_H_and_the_K_panels():
-    from geomlib.teaching.convergence import error_figure
+    from geomlib.teaching.figures.convergence import error_figure
 
     keys = [("H", "uniform"), ("H", "cotan, barycentric"), ("H", "cotan, mixed"), ("K", "barycentric"), ("K", "mixed")]
     rows = {"regular": [{"n": 10 * 4**s, "ell": e, **{k: (e**2, 0.1) for k in keys}} for s, e in enumerate([0.2, 0.1])]}

@@ -349,3 +349,49 @@ def test_the_syllabus_gives_each_notebook_its_time_exercises_and_discuss_points(
         auto, hand, minutes = auto + sum(points.values()), hand + by_hand, minutes + int(stated)
     assert f"{minutes} minutes" in text
     assert f"worth {auto + hand} points: {auto} auto-graded, {hand} by hand" in text
+
+
+def _time_lines():
+    """{notebook number: minutes} from the cores' **Time** lines."""
+    return {p.name[:2]: _stated_minutes(p) for p in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))}
+
+
+def test_the_readme_total_is_the_sum_of_the_notebooks_time_lines():
+    times = _time_lines()
+    assert None not in times.values(), f"a core without a Time line in minutes: {times}"
+    (total,) = re.findall(
+        r"the times below include the exercises, (\d+) minutes in all", (ROOT / "README.md").read_text()
+    )
+    assert int(total) == sum(times.values()), (
+        f"the README says {total} minutes, the Time lines add up to {sum(times.values())}"
+    )
+
+
+def test_the_assignment_page_states_each_notebooks_points_and_time():
+    """docs/assignment.md's table against the notebooks: every exercise and Discuss answer with the
+    points of its nbgrader grade cells, no other, and the notebook's Time line."""
+    import build_assignment
+
+    text = (ROOT / "docs" / "assignment.md").read_text()
+    rows = re.findall(r"^\| (\d) \| (\d\d) \| ([^|]*) \| ([^|]*) \| (\d+) min \|$", text, re.M)
+    assert [task for task, *_ in rows] == [str(i) for i in range(1, 8)], "seven tasks, in order"
+    times = _time_lines()
+    for task, notebook, functions, answers, minutes in rows:
+        (path,) = (ROOT / "notebooks").glob(f"{notebook}_*.ipynb")
+        nb = nbformat.read(path, as_version=4)
+        stated = {name: int(points) for name, points in re.findall(r"`(\w+)` \((\d+)\)", functions)}
+        assert stated == build_assignment.exercise_points(nb), (
+            f"task {task}: the functions' points differ from {path.name}"
+        )
+        stated = {name: int(points) for name, points in re.findall(r"`(\w+)` \((\d+)\)", answers)}
+        assert stated == build_assignment.discussion_points(nb), (
+            f"task {task}: the answers' points differ from {path.name}"
+        )
+        assert int(minutes) == times[notebook], f"task {task}: {minutes} min, {path.name} says {times[notebook]}"
+    assert f"adds {times['00']} minutes" in text
+
+
+def test_the_assignment_page_is_on_the_site_after_the_front_pages():
+    pages = list(build_site.doc_pages())
+    assert pages.index("docs/assignment.md") == pages.index("docs/README.md") + 1
+    assert build_site.doc_pages()["docs/assignment.md"] == "assignment.html"

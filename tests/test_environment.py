@@ -245,3 +245,51 @@ def test_workbook_opens_notebook_00_and_passes_arguments_on():
     assert notebook[-3:] == ["--port", "8899", "--allow-root"]
     assert workbook.front_end_command("lab", ["--allow-root"], root=True).count("--allow-root") == 1
     assert (workbook.NOTEBOOKS / workbook.FIRST_NOTEBOOK).is_file()
+
+
+def test_lab_options_choose_the_version_and_the_working_folder(tmp_path):
+    workbook = _workbook()
+    assert workbook.front_end_options(["--port", "8899"]) == (False, workbook.WORK, ["--port", "8899"])
+    assert workbook.front_end_options(["--solutions"]) == (True, workbook.WORK, [])
+    solutions, work, rest = workbook.front_end_options(["--work", str(tmp_path), "--no-browser"])
+    assert (solutions, work, rest) == (False, tmp_path.resolve(), ["--no-browser"])
+    assert workbook.front_end_options([f"--work={tmp_path}"])[1] == tmp_path.resolve()
+    lab = workbook.front_end_command("lab", [], folder=tmp_path)
+    assert lab[lab.index("--notebook-dir") + 1] == str(tmp_path)
+    # the default working folder sits beside notebooks/ (so ../docs links hold) and git ignores it
+    assert workbook.WORK.parent == workbook.NOTEBOOKS.parent
+    assert "/my-work/" in (ROOT / ".gitignore").read_text().split()
+
+
+def test_lab_adds_new_notebooks_and_never_overwrites_the_readers(tmp_path):
+    workbook = _workbook()
+    built, work = tmp_path / "built", tmp_path / "work"
+    built.mkdir()
+    (built / "00_a.ipynb").write_text("exercise version 00")
+    assert workbook.add_missing_notebooks(built, work) == (["00_a.ipynb"], [])
+    (work / "00_a.ipynb").write_text("the reader's attempt")  # the reader works on it
+    (built / "00_a.ipynb").write_text("an update of 00")  # the workbook is updated
+    (built / "01_b.ipynb").write_text("a new notebook")
+    assert workbook.add_missing_notebooks(built, work) == (["01_b.ipynb"], ["00_a.ipynb"])
+    assert (work / "00_a.ipynb").read_text() == "the reader's attempt"
+    assert (work / "01_b.ipynb").read_text() == "a new notebook"
+
+
+def test_lab_builds_the_exercise_version_and_the_solutions_with_a_banner(tmp_path):
+    import nbformat
+
+    spec = importlib.util.spec_from_file_location("build_assignment", ROOT / "tools" / "build_assignment.py")
+    build_assignment = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(build_assignment)
+    names = build_assignment.build_solutions(tmp_path / "solutions")
+    assert names == sorted(p.name for p in (ROOT / "notebooks").glob("*.ipynb"))
+    for name in names:
+        original = nbformat.read(ROOT / "notebooks" / name, 4)
+        shown = nbformat.read(tmp_path / "solutions" / name, 4)
+        assert shown.cells[0].source == build_assignment.SOLUTION_BANNER
+        assert [c.source for c in shown.cells[1:]] == [c.source for c in original.cells]
+    assert "Solution version" in build_assignment.SOLUTION_BANNER
+    build_assignment.build(tmp_path / "exercises")
+    stubbed = nbformat.read(tmp_path / "exercises" / "07_denoising_evaluation.ipynb", 4)
+    sources = "\n".join(c.source for c in stubbed.cells)
+    assert "NotImplementedError" in sources and "### BEGIN SOLUTION" not in sources

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from geomlib import MeshError
-from geomlib.lessons.filters import SCHEMES, mode_factor, plot_mode_factors
+from geomlib.lessons.filters import SCHEMES, mode_factor
+from geomlib.teaching.figures.filter_plots import plot_mode_factors
 
 
 def test_factors_at_known_points():

@@ -29,8 +29,8 @@ WIDGET = "application/vnd.jupyter.widget-view+json"
 
 
 def test_box_still_draws_the_views_inside_a_box_and_nothing_else():
-    from geomlib.teaching import surfaces
-    from geomlib.teaching.viewer import MeshView, box_still, side_by_side
+    from geomlib.teaching.display.viewer import MeshView, box_still, side_by_side
+    from geomlib.teaching.shapes import surfaces
 
     V, F = surfaces.icosphere(1)
     view = MeshView(V, F, values=V[:, 2], title="z")

@@ -12,10 +12,13 @@ from geomlib import MeshError, MeshWarning, laplacian, surfaces, vertex_areas
 from geomlib.lessons.laplace import (
     barycentric_areas,
     cotangent_matrix,
+    edge_lengths,
     face_geometry,
+    intrinsic_cotangent_matrix,
     mixed_areas,  # noqa: E402
     uniform_adjacency,
     uniform_laplacian,
+    voronoi_pieces,
 )
 
 AREAS = ("barycentric", "mixed")
@@ -371,8 +374,8 @@ def test_laplacian_measures_the_faces_once(monkeypatch):
     import geomlib.lessons.laplace as laplace
 
     calls = []
-    measure = laplace.face_geometry
-    monkeypatch.setattr(laplace, "face_geometry", lambda V, F: calls.append(1) or measure(V, F))
+    measure = laplace.FaceGeometry.of
+    monkeypatch.setattr(laplace.FaceGeometry, "of", lambda V, F: calls.append(1) or measure(V, F))
     V, F = surfaces.sphere(1.0, subdivisions=2).V, surfaces.sphere(1.0, subdivisions=2).F
     for area in ("barycentric", "mixed"):
         calls.clear()
@@ -380,3 +383,49 @@ def test_laplacian_measures_the_faces_once(monkeypatch):
         assert len(calls) == 1
         np.testing.assert_array_equal(C.toarray(), cotangent_matrix(V, F).toarray())
         np.testing.assert_array_equal(M.diagonal(), vertex_areas(V, F, area))
+
+
+def test_voronoi_pieces_fill_each_triangle_and_are_the_mixed_areas_without_an_obtuse_angle():
+    # the three circumcentric pieces of a triangle sum to its area, obtuse or not (signed areas)
+    V = np.array([[0.0, 0, 0], [4, 0, 0], [1, 1, 0], [2, -1.5, 0.3]])
+    F = np.array([[0, 1, 2], [0, 3, 1]])
+    pieces = voronoi_pieces(V, F)
+    assert np.allclose(pieces.sum(axis=1), face_geometry(V, F)[1] / 2)
+    assert pieces[0, 0] < 0  # at vertex 0 of the obtuse triangle: its other two angles differ by more than 90 degrees
+    s = surfaces.sphere(1.0, subdivisions=1)  # the icosphere has no obtuse triangle
+    summed = np.bincount(s.F.ravel(), voronoi_pieces(s.V, s.F).ravel(), minlength=len(s.V))
+    assert np.allclose(summed, mixed_areas(s.V, s.F))
+
+
+def test_intrinsic_cotangent_matrix_of_a_3_4_5_triangle_is_exact():
+    # corner 0 opposite the hypotenuse 5 (the right angle), corners 1 and 2 opposite 3 and 4; area 6
+    C = dense(intrinsic_cotangent_matrix([[5.0, 3.0, 4.0]], [[0, 1, 2]]))
+    # cot of the right angle is 0; cot theta_1 = 4/3 (opposite 3), cot theta_2 = 3/4 (opposite 4)
+    assert C[1, 2] == pytest.approx(0.0, abs=1e-15)
+    assert C[0, 2] == pytest.approx(0.5 * 4 / 3, rel=1e-15) and C[0, 1] == pytest.approx(0.5 * 3 / 4, rel=1e-15)
+    np.testing.assert_allclose(C.sum(axis=1), 0.0, atol=1e-15)
+
+
+def test_intrinsic_cotangent_matrix_needs_only_the_lengths():
+    V, F = icosphere(2, scale=(1.0, 0.7, 0.4))
+    l = edge_lengths(V, F)
+    Q = random_rotation(5)
+    # Heron's areas (no positions) give the matrix the positions give, and a rigid motion changes nothing
+    np.testing.assert_allclose(dense(intrinsic_cotangent_matrix(l, F)), dense(cotangent_matrix(V, F)), atol=1e-12)
+    np.testing.assert_allclose(edge_lengths(V @ Q.T + 3.0, F), l, rtol=1e-12)
+
+
+def test_intrinsic_cotangent_matrix_against_libigl():
+    igl = pytest.importorskip("igl")
+    e = surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=2, jitter=0.3, seed=1)
+    V, F = e.V, e.F
+    l = edge_lengths(V, F)
+    ref = igl.cotmatrix_intrinsic(l, F)
+    assert abs(intrinsic_cotangent_matrix(l, F) - ref).max() < 1e-12 * abs(ref).max()
+
+
+def test_intrinsic_cotangent_matrix_drops_a_flat_triangle_with_a_warning():
+    with pytest.warns(MeshWarning, match="zero-area"):
+        C = dense(intrinsic_cotangent_matrix([[2.0, 1.0, 1.0], [1.0, 1.0, 1.0]], [[0, 1, 2], [1, 3, 2]], n=5))
+    assert C.shape == (5, 5) and np.isfinite(C).all()
+    assert C[0].tolist() == [0.0] * 5 and C[4].tolist() == [0.0] * 5  # vertex 0 is only in the flat face

@@ -10,7 +10,7 @@ import pytest
 import trimesh
 
 import geomlib
-from geomlib.teaching import surfaces
+from geomlib.teaching.shapes import surfaces
 
 ROOT = Path(__file__).resolve().parents[1]
 MESHES = ROOT / "geomlib" / "meshes"
@@ -185,7 +185,7 @@ def test_analytic_meshes_lie_on_their_surfaces():
 
 
 def test_files_match_geomlib_surfaces():
-    """The analytic files are geomlib.teaching.surfaces' meshes written with 9 digits."""
+    """The analytic files are geomlib.teaching.shapes.surfaces' meshes written with 9 digits."""
     cases = {
         "sphere.obj": surfaces.sphere(1.0, subdivisions=4),
         "ellipsoid.obj": surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4),

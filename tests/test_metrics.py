@@ -412,7 +412,7 @@ SCHEMES = [("explicit", "uniform"), ("explicit", "cotan"), ("implicit", "uniform
 
 def smooth(V, F, method, weights, value, iterations):
     from geomlib import explicit_smoothing, implicit_smoothing
-    from geomlib.teaching.sweep import scale_free_step
+    from geomlib.teaching.experiments.sweep import scale_free_step
 
     step = scale_free_step(V, F, method, weights, value)
     run = explicit_smoothing if method == "explicit" else implicit_smoothing
@@ -451,7 +451,7 @@ def test_smoothing_a_clean_sphere_only_shrinks_it(method, weights):
 
 
 def test_sweep_records_what_a_direct_run_gives():
-    from geomlib.teaching.sweep import smoothing_sweep
+    from geomlib.teaching.experiments.sweep import smoothing_sweep
 
     V, F = icosphere(2)
     settings = dict(seed=3, explicit_fractions=(0.25, 0.5), implicit_steps=(0.1, 1.0), iterations=(1, 3, 5))
@@ -485,7 +485,7 @@ def test_a_failed_sweep_worker_is_reported_not_waited_for(monkeypatch, how):
     memory): the sweep raises a MeshError that says so, instead of hanging on the pipe."""
     import os
 
-    import geomlib.teaching.sweep as sweep_module
+    import geomlib.teaching.experiments.sweep as sweep_module
     from geomlib import MeshError, smoothing_sweep
 
     parent, real = os.getpid(), sweep_module._sweep_levels

@@ -104,6 +104,38 @@ def test_normal_noise_moves_along_the_geometry_vertex_normals():
 
 
 def _sphere():
-    from geomlib.teaching.surfaces import icosphere as ico
+    from geomlib.teaching.shapes.surfaces import icosphere as ico
 
     return ico(2)
+
+
+def test_the_sweep_is_implicit_smoothing_measured_after_every_count():
+    import geomlib
+
+    V, F = geomlib.load_mesh(geomlib.data_path("sphere.obj"))
+    W = add_noise(V, F, 0.05, 7)
+    taus, N = [3e-4, 3e-3, 3e-2], 12
+    tau, k, E = geomlib.denoising_sweep(W, F, V, taus, N)
+    assert E.shape == (3, N + 1)
+    assert np.allclose(E[:, 0], geomlib.vertex_rms(W, V), rtol=1e-12)  # 0 iterations: the noisy mesh
+    for i, t in enumerate(taus):
+        for count in (1, 5, N):
+            P = geomlib.implicit_smoothing(W, F, t, count)
+            assert np.isclose(E[i, count], geomlib.vertex_rms(P, V), rtol=1e-9)
+    assert E[taus.index(tau), k] == E.min() and k == int(np.argmin(E[taus.index(tau)]))
+    assert E.min() < E[0, 0]  # smoothing a noisy sphere helps at some setting
+
+
+def test_the_sweep_refuses_an_open_mesh_and_bad_steps():
+    import geomlib
+
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    F = np.array([[0, 1, 2]])
+    with pytest.raises(MeshError, match="closed"):
+        geomlib.denoising_sweep(V, F, V, [1e-3], 2)
+    S, G = geomlib.load_mesh(geomlib.data_path("sphere.obj"))
+    for taus in ([], [0.0], [float("nan")]):
+        with pytest.raises(MeshError, match="taus"):
+            geomlib.denoising_sweep(S, G, S, taus, 2)
+    with pytest.raises(MeshError, match="iterations"):
+        geomlib.denoising_sweep(S, G, S, [1e-3], 1.5)

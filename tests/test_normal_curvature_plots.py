@@ -4,7 +4,7 @@ import matplotlib
 import numpy as np
 import pytest
 
-from geomlib.teaching.normal_curvature_plots import (
+from geomlib.teaching.figures.normal_curvature_plots import (
     kappa_turn_figure,
     normal_section,
     normal_section_figure,

@@ -7,7 +7,8 @@ import pytest
 
 import geomlib
 from geomlib import check
-from geomlib.teaching.check.result import CheckFailed, Mistake, call, exercise, matrix_pair, use, vector
+from geomlib.teaching.check.catalogue import matrix_pair, vector
+from geomlib.teaching.check.result import CheckFailed, Mistake, call, exercise, use
 from geomlib.teaching.notebook import NOTE_PREFIX, ClaimFailed, claim, explain, note, show_source
 
 

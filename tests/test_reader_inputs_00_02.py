@@ -13,7 +13,7 @@ import sympy as sp
 from meshdata import COURSE, ROOT, needs_course
 from notebook_runner import Raw, ran
 
-from geomlib.teaching import surfaces
+from geomlib.teaching.shapes import surfaces
 
 NB00, NB01, NB02 = "00_getting_started.ipynb", "01_uniform_laplace_curvature.ipynb", "02_fundamental_forms.ipynb"
 NB01A = "01a_dig_deeper_tessellation.ipynb"

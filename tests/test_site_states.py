@@ -1,4 +1,4 @@
-"""geomlib.teaching.site_states: the slider states the website replays.
+"""geomlib.teaching.display.site_states: the slider states the website replays.
 
 A recorded state must be what the notebook's callback draws for that value: the
 test builds 01's tessellation slider (the same geomlib calls as its callback) on
@@ -16,8 +16,8 @@ import pytest
 
 from geomlib import gaussian_curvature as gaussian_K
 from geomlib import mean_curvature, surfaces
-from geomlib.teaching.site_states import MAX_VALUES, record, slider_values
-from geomlib.teaching.viewer import MeshView, side_by_side
+from geomlib.teaching.display.site_states import MAX_VALUES, record, slider_values
+from geomlib.teaching.display.viewer import MeshView, side_by_side
 
 N, JITTER_MAX, SEED = 6, 0.4, 3
 

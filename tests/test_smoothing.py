@@ -562,7 +562,7 @@ def test_the_engines_advance_by_the_shown_steps(monkeypatch, boundary_condition)
 
 
 def test_the_sweep_advances_by_the_shown_steps(monkeypatch):
-    from geomlib.teaching.sweep import smoothing_sweep
+    from geomlib.teaching.experiments.sweep import smoothing_sweep
 
     V, F = icosphere(1)
 

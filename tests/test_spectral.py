@@ -9,8 +9,8 @@ import pytest
 from meshdata import COURSE
 
 import geomlib
-import geomlib.numerics.cache as basis_cache
 import geomlib.numerics.eigen as eigen
+import geomlib.numerics.eigenbasis_store as basis_cache
 from geomlib import (
     MeshError,
     MeshWarning,
@@ -21,7 +21,7 @@ from geomlib import (
     spectral_cache_dir,
     spectral_reconstruction,
 )
-from geomlib.teaching.surfaces import ellipsoid, icosphere, sphere
+from geomlib.teaching.shapes.surfaces import ellipsoid, icosphere, sphere
 
 
 @pytest.fixture(autouse=True)

@@ -1,11 +1,11 @@
-"""Tests of geomlib.teaching.surfaces: exact truth, exact placement, closed and oriented meshes."""
+"""Tests of geomlib.teaching.shapes.surfaces: exact truth, exact placement, closed and oriented meshes."""
 
 import numpy as np
 import pytest
 from partials import central_partials
 
 from geomlib import MeshError
-from geomlib.teaching import surfaces as S
+from geomlib.teaching.shapes import surfaces as S
 
 # ---------------------------------------------------------------------------
 # independent helpers (written here, not imported from the module under test)
@@ -541,3 +541,29 @@ def test_ellipsoid_truth_at_the_poles(make):
     np.testing.assert_allclose(m.k1[poles], 0.5 / 0.7**2, rtol=1e-7)
     np.testing.assert_allclose(m.k2[poles], 0.5 / 1.0**2, rtol=1e-7)
     np.testing.assert_allclose(m.K[poles], 0.5**2 / (0.7**2 * 1.0**2), rtol=1e-13)
+
+
+def test_the_saddle_height_has_nine_saddles_eight_on_the_boundary():
+    # without the monkey term: grad z = 0 and det Hess z < 0 exactly at x, y in {-1, 0, 1}
+    # (the origin, the four edge midpoints and the four corners); the four bumps and dips are
+    # at x, y = +-1/sqrt(3), where det Hess z > 0
+    import sympy as sp
+
+    x, y = sp.symbols("x y", real=True)
+    z = sp.Rational(27, 4) * x * (1 - x**2) * y * (1 - y**2)
+    grad = [sp.diff(z, x), sp.diff(z, y)]
+    critical = sp.solve(grad, [x, y], dict=True)
+    hessian = sp.hessian(z, (x, y)).det()
+    saddles = sorted((p[x], p[y]) for p in critical if hessian.subs(p) < 0)
+    extrema = [p for p in critical if hessian.subs(p) > 0]
+    assert saddles == sorted((a, b) for a in (-1, 0, 1) for b in (-1, 0, 1))
+    assert len([s for s in saddles if 1 in map(abs, s)]) == 8 and len(extrema) == 4
+    assert all(abs(p[x]) == abs(p[y]) == 1 / sp.sqrt(3) for p in extrema)
+    # the function the meshes use is this polynomial
+    u = np.linspace(-1, 1, 7)
+    np.testing.assert_allclose(
+        S.saddle_height(u[:, None], u[None, :], amplitude=1.0, monkey=0.0),
+        sp.lambdify((x, y), z)(u[:, None], u[None, :]),
+        rtol=1e-14,
+        atol=1e-15,
+    )

@@ -1,4 +1,4 @@
-"""The comparison of notebook 07 (geomlib.teaching.sweep.denoising_comparison): what it records, its grids.
+"""The comparison of notebook 07 (geomlib.teaching.experiments.sweep.denoising_comparison): what it records, its grids.
 
 The grids of COMPARISON_GRIDS must bracket each method's best setting at the assignment's noise level on
 the shipped sphere (issue: no reported best setting on a grid's edge); the worker process gives the
@@ -11,7 +11,8 @@ import pytest
 import trimesh
 
 import geomlib
-from geomlib.teaching.sweep import COMPARISON_GRIDS, denoising_comparison, plot_comparison
+from geomlib.teaching.experiments.sweep import COMPARISON_GRIDS, denoising_comparison
+from geomlib.teaching.figures.denoising_plots import plot_comparison
 
 
 def icosphere(subdivisions):

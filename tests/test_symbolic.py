@@ -565,3 +565,36 @@ def test_frame_coefficients_are_the_shape_operator_in_the_orthonormal_frame():
     in_frame = np.linalg.solve(coords, L @ coords)
     np.testing.assert_allclose(in_frame, [[L11, L12], [L12, L22]], atol=1e-12)
     assert abs(L12) > 1e-3
+
+
+def test_unit_tangent_is_a_unit_vector_at_angle_phi_from_p_u():
+    E, F, G = 2.0, 0.7, 1.5  # I of some parameterisation, F != 0
+    I = np.array([[E, F], [F, G]])
+    for phi in (0.0, 0.3, 1.2, np.pi / 2, 2.9):
+        t = np.array(symbolic.unit_tangent(E, F, G, phi))
+        assert t @ I @ t == pytest.approx(1.0, rel=1e-14)
+        # cos of the angle to p_u = (1, 0) in the metric I is cos(phi)
+        assert t @ I @ np.array([1.0, 0.0]) / np.sqrt(E) == pytest.approx(np.cos(phi), abs=1e-14)
+
+
+def test_forms_normal_curvature_takes_any_forms_function():
+    a, b, c, u, v = 1.0, 0.7, 0.5, 0.7, 1.0
+    phis = np.array([0.0, 0.4, 2.0])
+    expected = symbolic.ellipsoid_normal_curvature(a, b, c, phis, u, v)
+    from_pair = symbolic.forms_normal_curvature(symbolic.ellipsoid_forms, a, b, c, u, v, phis)
+    np.testing.assert_allclose(from_pair, expected, rtol=1e-12)
+
+    def six(a, b, c, u, v):  # the same forms as six coefficients
+        I, II = symbolic.ellipsoid_forms(a, b, c, u, v)
+        return I[0, 0], I[0, 1], I[1, 1], II[0, 0], II[0, 1], II[1, 1]
+
+    np.testing.assert_allclose(symbolic.forms_normal_curvature(six, a, b, c, u, v, phis), expected, rtol=1e-12)
+
+    def sphere_forms(a, b, c, u, v):  # a sphere of radius a: every normal curvature is 1/a
+        s, t = sp.symbols("s t", real=True)
+        I, II = symbolic.ellipsoid_forms(a, a, a, s, t)
+        return I.subs({s: u, t: v}), II.subs({s: u, t: v})
+
+    np.testing.assert_allclose(
+        symbolic.forms_normal_curvature(sphere_forms, 2.0, 0, 0, 0.3, 1.1, phis), 0.5, rtol=1e-12
+    )

@@ -326,7 +326,7 @@ def test_boundary_counts_through_unpaired_vertices_match_the_full_edge_count():
     """The half-edge probes only skip work: on open, flipped, bow-tie and non-manifold meshes
     the boundary counts equal those of the full edge table."""
     from geomlib.mesh.topology import boundary_edge_counts, edge_face_counts, unpaired_vertices
-    from geomlib.teaching.surfaces import icosphere, plane
+    from geomlib.teaching.shapes.surfaces import icosphere, plane
 
     _, closed = icosphere(2)
     grid = plane(n=12).F

@@ -1,13 +1,16 @@
-"""Tests of the 3D views (geomlib.teaching.viewer, .colours, .stills): colour mapping, in-place updates, normals, the still
+"""Tests of the 3D views (geomlib.teaching.display.viewer, .colours, .stills): colour mapping, in-place updates, normals, the still
 picture in the display bundle, linked cameras and input checks.
 
 The browser side (does the canvas really show the mesh, does a slider change
 it, do linked cameras turn together) is tested in tests/browser/.
 """
 
+import ast
 import base64
 import io
+import json
 import re
+from pathlib import Path
 
 import ipywidgets
 import matplotlib
@@ -19,9 +22,9 @@ from PIL import Image
 
 from geomlib import MeshError
 from geomlib.mesh.geometry import vertex_normals
-from geomlib.teaching.colours import NAN_COLOR, NAN_NAME, colorize, value_range
-from geomlib.teaching.stills import render_still, view_normals
-from geomlib.teaching.viewer import MeshView, side_by_side, stills_only
+from geomlib.teaching.display.colours import NAN_COLOR, NAN_NAME, colorize, value_range
+from geomlib.teaching.display.stills import drawable, render_still, view_normals
+from geomlib.teaching.display.viewer import MeshView, side_by_side, stills_only
 
 
 @pytest.fixture(scope="module")
@@ -118,7 +121,7 @@ def test_nan_colour_stands_apart_from_the_maps_for_colour_blind_readers():
 
 
 def test_plot_cycle_is_colour_blind_safe_with_a_line_style_per_colour():
-    from geomlib.teaching.colours import PLOT_COLOURS, PLOT_LINESTYLES, plot_style
+    from geomlib.teaching.display.colours import PLOT_COLOURS, PLOT_LINESTYLES, plot_style
 
     cycle = list(plot_style()["axes.prop_cycle"])
     assert len(cycle) == len(PLOT_COLOURS) == len({str(c["linestyle"]) for c in cycle})  # no style repeats
@@ -315,7 +318,9 @@ def test_alt_text_says_mesh_quantity_range_nans_and_what_to_look_for(sphere, mes
     view.update(description="  the rim   flattens first ")  # a sentence of its own
     assert view.alt_text().endswith("(NaN), drawn bright violet. The rim flattens first.")
     # plain and zero views say so; no description, no trailing words
-    assert MeshView(V, F).alt_text() == "3D view: a mesh of 642 vertices and 1280 faces, plain shading (no colour map)."
+    assert (
+        MeshView(V, F).alt_text() == "3D view of a mesh of 642 vertices and 1280 faces, plain shading (no colour map)."
+    )
     zero = MeshView(V, F, values=np.zeros(len(V)), label="K")
     assert "coloured by K: 0 everywhere" in zero.alt_text() and zero.alt_text().endswith("drawn white.")
 
@@ -323,8 +328,8 @@ def test_alt_text_says_mesh_quantity_range_nans_and_what_to_look_for(sphere, mes
 def test_the_still_of_a_box_of_views_carries_their_alt_text(sphere):
     from IPython.core.formatters import DisplayFormatter
 
-    from geomlib.teaching import viewer
-    from geomlib.teaching.viewer import box_alt
+    from geomlib.teaching.display import viewer
+    from geomlib.teaching.display.viewer import box_alt
 
     V, F = sphere
     a, b = MeshView(V, F, title="a", description="look at a"), MeshView(V, F, title="b")
@@ -340,7 +345,7 @@ def test_the_still_of_a_box_of_views_carries_their_alt_text(sphere):
 
 def test_still_puts_the_mesh_in_the_middle():
     # a unit square facing the camera direction fills the middle, corners stay background
-    from geomlib.teaching.stills import UP, VIEW_DIRECTION, camera_basis
+    from geomlib.teaching.display.stills import UP, VIEW_DIRECTION, camera_basis
 
     right, up, w = camera_basis(VIEW_DIRECTION, UP)
     corners = np.array([-right - up, right - up, right + up, -right + up])
@@ -363,7 +368,7 @@ def test_still_puts_the_mesh_in_the_middle():
 
 def _word_gaps(title):
     """Widths of the blank column runs between the inked columns of a still's title line."""
-    from geomlib.teaching.stills import still_with_colorbar
+    from geomlib.teaching.display.stills import still_with_colorbar
 
     image = still_with_colorbar(np.full((20, 400, 3), 255, np.uint8), None, 0.0, 1.0, "", title)
     ink = (image[:18] < 128).any(axis=(0, 2))  # the title band above the picture
@@ -375,8 +380,8 @@ def _word_gaps(title):
 def test_still_titles_keep_their_spaces():
     # Pillow's default font has a 2 px space that hinting can remove ("implicitsmoothing")
     spaced, joined = _word_gaps("implicit smoothing, steps of 0.3"), _word_gaps("implicitsmoothing,stepsof0.3")
-    assert (spaced >= 3).sum() == 4  # the four spaces, each at least 3 px wide
-    assert (joined >= 3).sum() == 0  # letters within a word are never that far apart
+    assert (spaced >= 4).sum() == 4  # the four spaces, each at least 4 px wide
+    assert (joined >= 4).sum() == 0  # letters within a word are never that far apart (3 px at most)
 
 
 def test_plain_view_without_values(sphere):
@@ -389,6 +394,84 @@ def test_plain_view_without_values(sphere):
     assert "coloured" not in view.summary()
     image = view.still()
     assert np.any(image < 245, axis=2).mean() > 0.1
+
+
+def _screen(view, X):
+    """Pixel (column, row) of the points X (k, 3) in the view's still (no title above it)."""
+    from geomlib.teaching.display.stills import FOV, camera_basis
+
+    right, up, w = camera_basis(view._direction, view._up)
+    P = X - view._centre
+    depth = view._distance - P @ w
+    f = (view.height / 2) / np.tan(np.radians(FOV) / 2)
+    return (view.width / 2 + f * (P @ right) / depth).astype(int), (view.height / 2 - f * (P @ up) / depth).astype(int)
+
+
+def test_the_still_of_a_wireframe_view_draws_its_edges(sphere):
+    from geomlib.mesh.topology import edges
+
+    V, F = sphere
+    wire, plain = MeshView(V, F, wireframe=True).still(), MeshView(V, F).still()
+    darker = (plain.astype(int) - wire.astype(int)).sum(axis=2) > 60  # the edge colour at 0.45 over the surface
+    covered = np.any(plain < 245, axis=2)
+    rim = covered.copy()
+    rim[1:] |= covered[:-1]
+    rim[:-1] |= covered[1:]
+    rim[:, 1:] |= rim[:, :-1].copy()
+    rim[:, :-1] |= rim[:, 1:].copy()
+    assert not (darker & ~rim).any()  # the lines lie on the drawn surface (the outline's pixels next to it)
+    assert 0.05 < darker.sum() / covered.sum() < 0.4  # lines, not a fill
+    view = MeshView(V, F)
+    toward = np.asarray(view._direction) / np.linalg.norm(view._direction)  # from the centre to the eye
+    E = edges(F)
+    mid, centre = V[E].mean(axis=1), V[F].mean(axis=1)
+    # every edge facing the camera is drawn through its midpoint (within a pixel); the faces' centres stay clean
+    x, y = _screen(view, mid[mid @ toward > 0.5])
+    assert np.mean([darker[yy - 1 : yy + 2, xx - 1 : xx + 2].any() for xx, yy in zip(x, y)]) == 1.0
+    cx, cy = _screen(view, centre[centre @ toward > 0.5])
+    assert darker[cy, cx].mean() < 0.02
+    # the surface hides the edges behind it: drawn alone, they leave the picture as it was
+    colors = np.full((len(V), 3), 0.8)
+    behind = E[mid @ toward < -0.2]
+    assert np.array_equal(render_still(V, F, colors, edges=behind), render_still(V, F, colors))
+    assert not np.array_equal(render_still(V, F, colors, edges=E[mid @ toward > 0.2]), render_still(V, F, colors))
+
+
+def _notebook_views():
+    """(notebook, {keyword: expression}) of every ``MeshView(...)`` call in the notebooks' code cells."""
+    for path in sorted((Path(__file__).parents[1] / "notebooks").glob("*.ipynb")):
+        for cell in json.loads(path.read_text(encoding="utf-8"))["cells"]:
+            if cell["cell_type"] != "code":
+                continue
+            source = "".join(cell["source"])
+            code = "\n".join("" if line.lstrip().startswith(("%", "!")) else line for line in source.splitlines())
+            for node in ast.walk(ast.parse(code)):
+                if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "MeshView":
+                    yield path.name, {kw.arg: kw.value for kw in node.keywords}
+
+
+def _words(expression):
+    """The literal text of an expression: its string constants and the fixed parts of its f-strings."""
+    return " ".join(n.value for n in ast.walk(expression) if isinstance(n, ast.Constant) and isinstance(n.value, str))
+
+
+def test_the_stills_font_draws_every_character_of_the_notebooks_titles_and_labels():
+    texts = [_words(kw[key]) for _, kw in _notebook_views() for key in ("title", "label") if key in kw]
+    assert len(texts) > 40
+    assert "²" in "".join(texts)  # the labels write units as 1/length², not 1/length^2
+    assert drawable("".join(texts)) == []  # no character drawn as a box
+    assert drawable("K (1/length²) λ τ σ κ φ − × ·") == []
+
+
+def test_every_view_of_the_notebooks_names_what_it_shows():
+    # its alt text begins "3D view of" the title: a noun phrase, not a participle ("3D view of coloured by height")
+    views = list(_notebook_views())
+    assert len(views) > 20
+    untitled = [name for name, kw in views if "title" not in kw]
+    assert untitled == []
+    first = [(name, _words(kw["title"]).split()[:1]) for name, kw in views if isinstance(kw["title"], ast.Constant)]
+    not_a_name = {"coloured", "colored", "drawn", "shown", "smoothed", "with", "after", "by", "of"}
+    assert [(name, w) for name, w in first if w and w[0] in not_a_name] == []
 
 
 # --- side by side -----------------------------------------------------------
@@ -411,7 +494,9 @@ def test_side_by_side_links_cameras(sphere):
     assert row._distance > MeshView(V, F)._distance  # b is twice as large
     bundle, metadata = row._repr_mimebundle_()
     assert metadata["image/png"]["alt"].startswith("View 1 of 3: 3D view of a: a mesh of 642 vertices")
-    assert "View 3 of 3: 3D view: a mesh of 642 vertices and 1280 faces, plain shading" in metadata["image/png"]["alt"]
+    assert (
+        "View 3 of 3: 3D view of a mesh of 642 vertices and 1280 faces, plain shading" in metadata["image/png"]["alt"]
+    )
     image = _decode(bundle)
     assert image.shape[1] == 3 * a.width + 2 * 8
     assert bundle["text/plain"].count("MeshView") == 3
@@ -498,7 +583,7 @@ def test_values_of_wrong_length(sphere):
 
 
 def test_closed_outward_takes_the_mesh_cores_volume(sphere, monkeypatch):
-    import geomlib.teaching.viewer as viewer
+    import geomlib.teaching.display.viewer as viewer
 
     V, F = sphere
     monkeypatch.setattr(viewer, "enclosed_volume", lambda V, F: -1.0)
@@ -525,7 +610,7 @@ def test_back_faces_skipped_only_on_closed_outward_meshes(sphere):
 
 
 def test_a_field_zero_up_to_rounding_draws_white(sphere):
-    from geomlib.teaching.colours import ZERO_COLOR
+    from geomlib.teaching.display.colours import ZERO_COLOR
 
     V, F = sphere
     rounding = 8e-13 * np.sin(7 * V[:, 0])  # a flat mesh's H, say: zero but for rounding
@@ -571,6 +656,29 @@ def test_frame_keeps_a_collapsed_mesh_at_the_input_scale(sphere):
     distance = view._distance
     view.update(V=collapsed)
     assert view._distance == distance and covered(view) < 0.01 * covered(MeshView(V, F))
+
+
+def test_fit_draws_a_collapse_or_an_explosion_at_the_frames_size_and_says_so(sphere):
+    V, F = sphere
+    view = MeshView(V, F, title="smoothing", fit=True)
+
+    def covered():
+        return np.any(view.still()[18 : 18 + view.height] < 245, axis=2).mean()
+
+    full = covered()
+    view.update(V=0.5 * V + 0.1)  # shrunk to half: drawn as it is, so the shrinkage is seen
+    assert view._title.value == "<b>smoothing</b>" and 0.15 * full < covered() < 0.35 * full
+    view.update(V=1e-6 * V + 0.3)  # collapsed: a speck, drawn a million times larger at the frame's centre
+    assert "drawn 1e+06 x larger" in view._title.value and "drawn 1e+06 times larger" in view.alt_text()
+    assert covered() == pytest.approx(full, rel=0.02)
+    stretched = V * [30.0, 1.0, 1.0]  # a volume kept by a large stretch: out of the frame, drawn smaller
+    view.update(V=stretched)
+    assert "drawn 17.3 x smaller" in view._title.value  # the bounding boxes' diagonals: sqrt(902 / 3)
+    picture = np.any(view.still()[18 : 18 + view.height] < 245, axis=2)
+    assert picture.any() and not (picture[0].any() or picture[-1].any() or picture[:, 0].any() or picture[:, -1].any())
+    view.update(V=V)
+    assert view._title.value == "<b>smoothing</b>" and covered() == pytest.approx(full)
+    assert MeshView(1e-6 * V, F, frame=V)._fitted == 1.0  # without fit: the frame's scale, always
 
 
 def test_linked_views_of_very_different_sizes_are_not_specks(sphere):

@@ -2,6 +2,7 @@
 """Write the assignment version of the workbook: solutions replaced by stubs.
 
     python tools/build_assignment.py [--out build/assignment]
+    python tools/build_assignment.py --solutions --out build/solutions
 
 The notebooks in notebooks/ are the solution version. An exercise's solution
 is marked as nbgrader marks it: the code cell has the metadata
@@ -30,6 +31,10 @@ reads it in the feedback).
 
 The output folder holds the notebooks and a copy of nothing else: they import
 geomlib from the installed package and find the shipped meshes through it.
+
+``--solutions`` writes the solution version instead, for a reader studying on
+their own (``workbook.py lab --solutions``): the notebooks as they are, each
+opening with a banner cell that says it holds the answers.
 """
 
 import argparse
@@ -45,6 +50,12 @@ _BLOCK = re.compile(r"^([ \t]*)### BEGIN SOLUTION[^\n]*\n.*?^[ \t]*### END SOLUT
 HIDDEN_BEGIN, HIDDEN_END = "### BEGIN HIDDEN TESTS", "### END HIDDEN TESTS"
 _HIDDEN = re.compile(r"^[ \t]*### BEGIN HIDDEN TESTS[^\n]*\n.*?^[ \t]*### END HIDDEN TESTS[^\n]*(\n|$)", re.M | re.S)
 ANSWER_BOX = "*Your answer here: {points} point{s}, graded by hand.*"
+SOLUTION_BANNER = (
+    "> **Solution version.** Every exercise of this copy holds its answer and every **Discuss** its model "
+    "answer. Attempt the exercise version first: `python3 workbook.py lab` opens it in your own folder, "
+    "`my-work/`. This copy is rewritten each time `python3 workbook.py lab --solutions` runs, so edits here "
+    "do not last."
+)
 
 
 def stub_source(source, exercise, reread):
@@ -174,12 +185,29 @@ def build(out):
     return written
 
 
+def build_solutions(out):
+    """The notebooks of notebooks/ into ``out``, each with SOLUTION_BANNER as its first cell."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        banner = nbformat.v4.new_markdown_cell(SOLUTION_BANNER)
+        banner.id = "solution-version-banner"
+        nb.cells.insert(0, banner)
+        nbformat.write(nb, out / path.name)
+        written.append(path.name)
+    return written
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "build" / "assignment")
+    parser.add_argument("--solutions", action="store_true", help="the solution version, with a banner")
+    parser.add_argument("--quiet", action="store_true", help="print nothing when all goes well")
     args = parser.parse_args(argv)
-    names = build(args.out)
-    print(f"wrote {len(names)} assignment notebooks to {args.out}")
+    names = build_solutions(args.out) if args.solutions else build(args.out)
+    if not args.quiet:
+        print(f"wrote {len(names)} {'solution' if args.solutions else 'assignment'} notebooks to {args.out}")
     return 0
 
 

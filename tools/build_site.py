@@ -19,7 +19,7 @@ static web server and from ``file://``.
 
 Sliders move the 3D views in the page too, with no kernel: their states are
 computed when the site is built. After the notebook's last cell has run,
-:func:`geomlib.teaching.site_states.record` runs in the same kernel for every cell
+:func:`geomlib.teaching.display.site_states.record` runs in the same kernel for every cell
 that showed widgets: it sets each of the cell's sliders, from the value it was left at, one at a time from the others' defaults, to a short list
 of values (every integer up to 10, then 15, 20, 30, 50, 100, ...; a long grid
 thinned to about 20 positions, both ends kept: past a stability limit for the
@@ -79,6 +79,7 @@ NOTEBOOK_GLOBS = ("[0-9][0-9]_*.ipynb", "[0-9][0-9]a_*.ipynb")
 DOC_PAGES = {
     "README.md": "about.html",
     "docs/README.md": "docs.html",
+    "docs/assignment.md": "assignment.html",
     "docs/install.md": "install.html",
     "docs/grading.md": "grading.html",
     "docs/experiments.md": "experiments.html",
@@ -272,7 +273,7 @@ def _shown(cell):
 def execute(path, timeout=1200):
     """Run the notebook at ``path`` top to bottom in its folder; the widget state is stored.
 
-    After the last cell, :func:`geomlib.teaching.site_states.record` runs in the same
+    After the last cell, :func:`geomlib.teaching.display.site_states.record` runs in the same
     kernel for every cell that displayed widgets and records the states of its
     sliders, from the values they were left at. Returns
     ``(nb, recorded)`` with ``recorded`` mapping a cell's index to what was recorded
@@ -312,7 +313,7 @@ def execute(path, timeout=1200):
                 target = Path(tmp) / f"{i}.json"
                 # a call that leaves no name behind in the reader's namespace
                 probe = nbformat.v4.new_code_cell(
-                    f"__import__('geomlib.teaching.site_states', fromlist=['record']).record({ids!r}, {str(target)!r})"
+                    f"__import__('geomlib.teaching.display.site_states', fromlist=['record']).record({ids!r}, {str(target)!r})"
                 )
                 await client.async_execute_cell(probe, cell_index, store_history=False)
                 errors = [f"{o['ename']}: {o['evalue']}" for o in probe.outputs if o.get("output_type") == "error"]

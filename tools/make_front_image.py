@@ -26,8 +26,8 @@ SIZE = (300, 250)  # width and height of each view, pixels
 def front_image():
     """(h, w, 3) uint8: the three stills side by side."""
     import geomlib
-    from geomlib.teaching.stills import in_a_row
-    from geomlib.teaching.viewer import MeshView
+    from geomlib.teaching.display.stills import in_a_row
+    from geomlib.teaching.display.viewer import MeshView
 
     w, h = SIZE
     V, F = geomlib.load_mesh(geomlib.data_path("torus.obj"))

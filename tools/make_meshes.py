@@ -45,8 +45,8 @@ from geomlib.mesh.geometry import (  # noqa: E402
     mean_edge_length,
 )
 from geomlib.mesh.topology import Topology, boundary_loops, euler_characteristic  # noqa: E402
-from geomlib.teaching import surfaces  # noqa: E402
-from geomlib.teaching.surfaces import grid_faces  # noqa: E402
+from geomlib.teaching.shapes import surfaces  # noqa: E402
+from geomlib.teaching.shapes.surfaces import grid_faces  # noqa: E402
 
 FLOAT = "%.9g"
 
@@ -516,14 +516,14 @@ SPECS = [
     Spec(
         "plane.obj",
         lambda: _from_surface(surfaces.plane(n=PLANE_N, size=2.0)),
-        f"`geomlib.teaching.surfaces.plane(n={PLANE_N}, size=2.0)`: regular grid on [-1, 1]^2, z = 0, each square split by the same diagonal. Exact H = K = 0.",
+        f"`geomlib.teaching.shapes.surfaces.plane(n={PLANE_N}, size=2.0)`: regular grid on [-1, 1]^2, z = 0, each square split by the same diagonal. Exact H = K = 0.",
         "01, 03: flat mesh, every curvature estimate should give 0",
         False,
     ),
     Spec(
         "plane_irregular.obj",
         lambda: _from_surface(surfaces.plane(n=PLANE_N, size=2.0, jitter=0.3, seed=1)),
-        f"`geomlib.teaching.surfaces.plane(n={PLANE_N}, size=2.0, jitter=0.3, seed=1)`: the same grid with every vertex moved in the plane by up to 0.3 grid steps (boundary vertices along their side). Exact H = K = 0.",
+        f"`geomlib.teaching.shapes.surfaces.plane(n={PLANE_N}, size=2.0, jitter=0.3, seed=1)`: the same grid with every vertex moved in the plane by up to 0.3 grid steps (boundary vertices along their side). Exact H = K = 0.",
         "01, 03: uniform weights see curvature on a flat but irregular mesh, cotan weights do not; the clean reference of plane_noisy.obj",
         False,
     ),
@@ -537,35 +537,35 @@ SPECS = [
     Spec(
         "saddle.obj",
         lambda: _from_surface(surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)),
-        '`geomlib.teaching.surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)`: z = 0.2 (27/4) x (1 - x^2) y (1 - y^2) + 0.1 (x^3 - 3 x y^2) over [-1, 1]^2, (x, y) jittered by up to 0.3 grid steps, z evaluated again. Exact truth: `geomlib.teaching.surfaces.attach_truth("saddle", V, F)`.',
+        '`geomlib.teaching.shapes.surfaces.saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.3, seed=3)`: z = 0.2 (27/4) x (1 - x^2) y (1 - y^2) + 0.1 (x^3 - 3 x y^2) over [-1, 1]^2, (x, y) jittered by up to 0.3 grid steps, z evaluated again. Exact truth: `geomlib.teaching.shapes.surfaces.attach_truth("saddle", V, F)`.',
         "01, 03: open curved surface with K < 0 and K > 0 regions, a boundary, and many obtuse triangles (mixed vs barycentric areas)",
         False,
     ),
     Spec(
         "sphere.obj",
         lambda: _from_surface(surfaces.sphere(1.0, subdivisions=4)),
-        "`geomlib.teaching.surfaces.sphere(1.0, subdivisions=4)`: icosphere of radius 1. Exact H = 1, K = 1.",
+        "`geomlib.teaching.shapes.surfaces.sphere(1.0, subdivisions=4)`: icosphere of radius 1. Exact H = 1, K = 1.",
         "00, 01, 03: H = 1/r, Gauss-Bonnet (integral of K = 4 pi)",
         True,
     ),
     Spec(
         "ellipsoid.obj",
         lambda: _from_surface(surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)),
-        '`geomlib.teaching.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)`: the icosphere mapped by (x, y, z) -> (a x, b y, c z), a, b, c = 1.0, 0.7, 0.5. Exact truth: `geomlib.teaching.surfaces.attach_truth("ellipsoid", V, F, a=1.0, b=0.7, c=0.5)` (from geomlib.lessons.symbolic).',
+        '`geomlib.teaching.shapes.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4)`: the icosphere mapped by (x, y, z) -> (a x, b y, c z), a, b, c = 1.0, 0.7, 0.5. Exact truth: `geomlib.teaching.shapes.surfaces.attach_truth("ellipsoid", V, F, a=1.0, b=0.7, c=0.5)` (from geomlib.lessons.symbolic).',
         "02, 03: discrete curvature against the exact curvature of the fundamental forms",
         True,
     ),
     Spec(
         "ellipsoid_jittered.obj",
         lambda: _from_surface(surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)),
-        "`geomlib.teaching.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)`: the same surface, every vertex moved along the surface by up to 0.3 of its mean edge length (on the unit sphere, before the map). Same exact truth.",
+        "`geomlib.teaching.shapes.surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=4, jitter=0.3, seed=4)`: the same surface, every vertex moved along the surface by up to 0.3 of its mean edge length (on the unit sphere, before the map). Same exact truth.",
         "03: the same comparison on an irregular tessellation (uniform weights break down, cotan weights hold)",
         True,
     ),
     Spec(
         "torus.obj",
         lambda: _from_surface(surfaces.torus(1.0, 0.4, n=80, m=32)),
-        '`geomlib.teaching.surfaces.torus(1.0, 0.4, n=80, m=32)`: R = 1, r = 0.4, an 80 x 32 grid in (u, v), no seam duplicates. Exact truth: `geomlib.teaching.surfaces.attach_truth("torus", V, F, R=1.0, r=0.4)`.',
+        '`geomlib.teaching.shapes.surfaces.torus(1.0, 0.4, n=80, m=32)`: R = 1, r = 0.4, an 80 x 32 grid in (u, v), no seam duplicates. Exact truth: `geomlib.teaching.shapes.surfaces.attach_truth("torus", V, F, R=1.0, r=0.4)`.',
         "01, 03: K of both signs, Gauss-Bonnet with Euler characteristic 0",
         True,
     ),
@@ -654,7 +654,7 @@ notebook, open one with `geomlib.load_mesh(geomlib.data_path("sphere.obj"))`.
 All are triangle meshes, counter-clockwise seen from outside (from +z for the
 open height fields), with no zero-area faces, no duplicate or unused vertices
 and one connected component. The exact curvature of the analytic ones is
-`geomlib.teaching.surfaces.attach_truth(name, V, F, **params)` (from `geomlib.lessons.symbolic`),
+`geomlib.teaching.shapes.surfaces.attach_truth(name, V, F, **params)` (from `geomlib.lessons.symbolic`),
 with the parameters below.
 
 The table is written by the generator from the files themselves.

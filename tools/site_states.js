@@ -1,6 +1,6 @@
 // The website's precomputed sliders (copied by tools/build_site.py to assets/site/).
 //
-// The page holds, in <script id="site-states">, what geomlib.teaching.site_states
+// The page holds, in <script id="site-states">, what geomlib.teaching.display.site_states
 // recorded when the site was built: per cell, its sliders, each with its values
 // and, per value, the new contents of the widget traits its callback changed
 // (pythreejs buffer arrays, read-out text). This script finds those widget models

@@ -47,10 +47,10 @@ import warnings
 import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
-from ..mesh.geometry import vertex_normals
+from ..mesh.geometry import area_weighted_normals
 from ..mesh.topology import boundary_edge_counts, edges_at_unpaired_vertices
 from ..mesh.validate import as_mesh, check_choice
-from .laplace import check_options, face_geometry, laplacian, measured_blocks, vertex_areas, warn_zero_area
+from .laplace import FaceGeometry, assemble_laplacian, check_options, face_geometry, vertex_areas, warn_zero_area
 
 __all__ = [
     "mean_curvature",
@@ -107,7 +107,7 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
     check_options(weights, area)
     check_choice("boundary", boundary, MEAN_BOUNDARY_RULES)
     V, F = as_mesh(V, F)
-    M, C = laplacian(V, F, weights, area)
+    M, C = assemble_laplacian(V, F, weights, area)
     A = M.diagonal()
     if (A <= 0).any():
         _warn(
@@ -116,11 +116,11 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
         )
     DV = (C @ V) / np.where(A > 0, A, np.nan)[:, None]  # Delta x = M^-1 C x
     if signed:
-        H = -0.5 * np.einsum("ij,ij->i", DV, vertex_normals(V, F))
+        H = -0.5 * np.einsum("ij,ij->i", DV, area_weighted_normals(V, F))
     else:
         H = 0.5 * np.linalg.norm(DV, axis=1)
     if boundary != "formula":
-        on_boundary = boundary_mask(V, F)
+        on_boundary = boundary_edge_counts(F, len(V)) > 0  # as boundary_mask(V, F)
         H[on_boundary] = np.nan if boundary == "nan" else 0.0
         if on_boundary.all():
             _warn(
@@ -167,11 +167,11 @@ def angle_and_area_sums(V, F, area=None):
     (V, F) as ``geomlib.mesh.validate.as_mesh`` returns them.
     """
     theta_sum, A, degenerate = np.zeros(len(V)), None if area is None else np.zeros(len(V)), []
-    for block, faces in measured_blocks(V, F):
+    for block, faces in FaceGeometry.blocks(V, F):
         np.add.at(theta_sum, block.T.ravel(), face_angles(faces).T.ravel())  # in place: no (n,) array per block
         if area is not None:
             A += vertex_areas(V, block, area, faces)
-            degenerate.append(faces[3])
+            degenerate.append(faces.degenerate)
         del faces  # before the next block is measured, not after
     if area is not None:
         warn_zero_area(np.concatenate(degenerate), stacklevel=4)
@@ -188,7 +188,11 @@ def angle_deficit(V, F, theta_sum=None):
     of (V, F) when the caller has it already.
     """
     V, F = as_mesh(V, F)
-    theta_sum = angle_sums(V, F) if theta_sum is None else theta_sum
+    return deficit_of(V, F, angle_and_area_sums(V, F)[0] if theta_sum is None else theta_sum)
+
+
+def deficit_of(V, F, theta_sum):
+    """:func:`angle_deficit` of a checked mesh with its angle sums ``theta_sum`` (n,)."""
     deficit = 2.0 * np.pi - theta_sum
     unreferenced = theta_sum == 0  # in a triangle of non-zero area a vertex has an angle > 0
     if unreferenced.any():  # only then count the triangles at each vertex
@@ -239,7 +243,7 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
         raise MeshError(f"boundary must be one of {BOUNDARY_RULES}, not {boundary!r}")
     V, F = as_mesh(V, F)
     theta_sum, A = angle_and_area_sums(V, F, None if integrated else area)  # one pass over the faces
-    K = angle_deficit(V, F, theta_sum)  # 2 pi - sum theta
+    K = deficit_of(V, F, theta_sum)  # 2 pi - sum theta
     if boundary != "deficit":
         E, faces_at_edge = edges_at_unpaired_vertices(F, len(V))  # a closed mesh sorts nothing
         b = np.bincount(E[faces_at_edge == 1].ravel(), minlength=len(V))  # boundary edges at each vertex

@@ -28,7 +28,7 @@ import numpy as np
 from ..mesh.errors import MeshError
 from ..mesh.validate import check_choice
 
-__all__ = ["SCHEMES", "mode_factor", "plot_mode_factors"]
+__all__ = ["SCHEMES", "mode_factor"]
 
 SCHEMES = ("diffusion", "explicit", "implicit", "crank-nicolson", "taubin")
 
@@ -68,74 +68,3 @@ def mode_factor(lam, tau, scheme, tau_inflate=None):
             f"tau_inflate={tau_inflate!r}"
         )
     return (1.0 - x) * (1.0 - tau_inflate * np.asarray(lam, dtype=float))
-
-
-#: How each curve is drawn: line style and marker as well as colour, so that no curve is told
-#: apart by its colour alone.
-STYLES = {
-    "diffusion": dict(color="k", ls="-"),
-    "explicit": dict(color="C3", ls="-", marker="o"),
-    "implicit": dict(color="C0", ls="--"),
-    "crank-nicolson": dict(color="C2", ls="-."),
-    "taubin": dict(color="C1", ls=":", marker="s"),
-}
-
-
-def plot_mode_factors(lam_min, lam_max, tau, taubin=None, ax=None, title=None, past=None):
-    """Plot the per-mode factor of each scheme against lam, with the mesh's eigenvalue range shaded.
-
-    Parameters
-    ----------
-    lam_min, lam_max : float, smallest non-zero and largest eigenvalue of the mesh's operator.
-    tau : float, the step of the explicit, implicit and Crank-Nicolson schemes and of diffusion.
-    taubin : (tau_shrink, tau_inflate), optional, Taubin's pair in the same operator's units.
-    ax : matplotlib axes, optional.
-    past : float, optional
-        A second explicit step, drawn dashed, with a marker where its factor leaves [-1, 1]
-        (at lam = 2 / past): a step past the limit 2 / lam_max shows where the scheme breaks.
-
-    Every curve differs from the others by its line style or marker, not by colour alone.
-    Returns the axes.
-    """
-    import matplotlib.pyplot as plt
-
-    ax = ax or plt.subplots(figsize=(7, 3.6))[1]
-    lam = np.linspace(0.0, 1.15 * lam_max, 600)
-    every = dict(markevery=60, markersize=4)
-    for scheme in ("diffusion", "explicit", "implicit", "crank-nicolson"):
-        ax.plot(lam, mode_factor(lam, tau, scheme), lw=1.4, label=scheme, **STYLES[scheme], **every)
-    if taubin is not None:
-        label = f"Taubin ({taubin[0]:.3g}, {taubin[1]:.3g})"
-        ax.plot(lam, mode_factor(lam, taubin[0], "taubin", taubin[1]), lw=1.4, label=label, **STYLES["taubin"], **every)
-    if past is not None:
-        ax.plot(
-            lam,
-            mode_factor(lam, past, "explicit"),
-            color="C3",
-            ls="--",
-            marker="o",
-            fillstyle="none",
-            lw=1.2,
-            label=rf"explicit, $\tau$ = {past:.3g} (past the limit)",
-            **every,
-        )
-        ax.plot(
-            [2.0 / past],
-            [-1.0],
-            "v",
-            color="C3",
-            markersize=8,
-            label=rf"leaves $[-1, 1]$ at $\lambda$ = {2.0 / past:.3g}",
-        )
-    ax.axvspan(lam_min, lam_max, color="0.9", zorder=0, label="this mesh's eigenvalues")
-    ax.axhline(0, color="0.5", lw=0.6)
-    for y in (-1, 1):
-        ax.axhline(y, color="0.5", lw=0.6, ls=":")
-    ax.set(
-        xlabel=r"eigenvalue $\lambda$",
-        ylabel="factor per step",
-        ylim=(-2.2, 1.2),
-        title=title or rf"one step, $\tau$ = {tau:.3g}",
-    )
-    ax.legend(fontsize=8, loc="lower left")
-    return ax

@@ -31,25 +31,38 @@ Names: a function called ``*_laplacian`` returns the pair ``(M, C)``
 (:func:`laplacian`, :func:`uniform_laplacian`, and the ``cotangent_laplacian``
 a learner writes in notebook 03); one called ``*_matrix`` or ``*_areas``
 returns one matrix or one vector (:func:`cotangent_matrix`, :func:`vertex_areas`).
+
+Validation: each public function checks its mesh once, at its door
+(:func:`geomlib.mesh.validate.as_mesh`), and measures its faces once
+(:class:`FaceGeometry`); the functions it composes take that record as ``faces=``
+and read (V, F) as checked. :func:`assemble_laplacian` is :func:`laplacian` for a
+checked mesh, the one the operator and the curvature lessons compose.
 """
 
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..mesh.errors import MeshWarning, format_indices
-from ..mesh.geometry import corner_positions, cross, face_blocks
+from ..mesh.geometry import FACE_BLOCK, corner_positions, cross, face_blocks
 from ..mesh.topology import edges
-from ..mesh.validate import as_mesh, check_choice, is_zero_area
+from ..mesh.validate import as_faces, as_mesh, check_choice, is_zero_area
 
 __all__ = [
     "laplacian",
+    "assemble_laplacian",
+    "graph_laplacian",
+    "FaceGeometry",
     "uniform_laplacian",
     "cotangent_matrix",
+    "intrinsic_cotangent_matrix",
+    "edge_lengths",
     "vertex_areas",
     "barycentric_areas",
     "mixed_areas",
+    "voronoi_pieces",
     "face_geometry",
     "uniform_adjacency",
     "WEIGHTS",
@@ -71,14 +84,16 @@ def check_options(weights=None, area=None):
         check_choice("area", area, AREAS)
 
 
-def face_geometry(V, F):
-    """Per face: squared edge lengths, twice the area, corner cotangents, zero-area flag.
+class FaceGeometry(NamedTuple):
+    """Per face of a checked mesh: what the cotangent Laplacian and the vertex areas read, measured once.
 
     Corner ``i`` of face ``(v0, v1, v2)`` sits opposite the edge ``e_i = v_k - v_j``
-    (``j, k`` the next two corners).
+    (``j, k`` the next two corners). A public call measures it once at its door
+    (:meth:`of`, after :func:`geomlib.mesh.validate.as_mesh`) and hands it to the
+    functions it composes as ``faces=``.
 
-    Returns
-    -------
+    Fields
+    ------
     l2 : (m, 3) float64
         ``l2[f, i] = |e_i|^2`` (length^2).
     dblA : (m,) float64
@@ -89,12 +104,44 @@ def face_geometry(V, F):
     degenerate : (m,) bool
         Zero-area faces (:func:`geomlib.mesh.validate.is_zero_area`).
     """
+
+    l2: np.ndarray
+    dblA: np.ndarray
+    cot: np.ndarray
+    degenerate: np.ndarray
+
+    @classmethod
+    def of(cls, V, F):
+        """The record of a checked (V, F) (as ``as_mesh`` returns them), measured block by block.
+
+        Only one block's corner temporaries exist at a time (:func:`blocks`): at 655k vertices
+        tens of MB instead of hundreds.
+        """
+        if len(F) <= FACE_BLOCK:
+            return cls(*corner_geometry(*corner_positions(V, F)))
+        parts = [faces for _, faces in cls.blocks(V, F)]
+        return cls(*(np.concatenate(field) for field in zip(*parts)))
+
+    @classmethod
+    def blocks(cls, V, F):
+        """``(block, record of block)`` for each of ``geomlib.mesh.geometry.face_blocks(F)`` (checked V, F)."""
+        Vt = np.ascontiguousarray(V.T).T  # V, transposed once: corner_positions then copies nothing per block
+        for block in face_blocks(F):
+            yield block, cls(*corner_geometry(*corner_positions(Vt, block)))
+
+
+def face_geometry(V, F):
+    """The :class:`FaceGeometry` of (V, F): squared edge lengths, twice the areas, corner cotangents, zero-area flags.
+
+    Unpacks as ``l2, dblA, cot, degenerate = face_geometry(V, F)``; see :class:`FaceGeometry`
+    for the shapes and units.
+    """
     V, F = as_mesh(V, F)
-    return corner_geometry(*corner_positions(V, F))
+    return FaceGeometry.of(V, F)
 
 
 def corner_geometry(v0, v1, v2):
-    """:func:`face_geometry` from the (3, m) coordinate rows of the corners (unchecked input)."""
+    """:class:`FaceGeometry`'s fields from the (3, m) coordinate rows of the corners (unchecked input)."""
     e = (v2 - v1, v0 - v2, v1 - v0)  # e_i = v_k - v_j, the edge opposite corner i
     l2 = np.stack([np.einsum("cf,cf->f", ei, ei) for ei in e])  # |e_i|^2, (3, m)
     N2 = cross(e[1], e[2])  # (v0 - v2) x (v1 - v0) = (v1 - v0) x (v2 - v0) = 2 A n
@@ -104,40 +151,6 @@ def corner_geometry(v0, v1, v2):
     cot[:, degenerate] = 0.0
     # one row per face for the reader; the (3, m) arrays underneath keep each corner contiguous
     return l2.T, dblA, cot.T, degenerate
-
-
-def measured_blocks(V, F):
-    """``(block, face_geometry(V, block))`` for each of ``geomlib.mesh.geometry.face_blocks(F)``.
-
-    Unchecked input: the caller has validated V and F, once rather than once per block. A sum
-    over faces done this way holds one block's corner temporaries at a time: at 655k vertices
-    tens of MB instead of hundreds.
-    """
-    Vt = np.ascontiguousarray(V.T).T  # V, transposed once: corner_positions then copies nothing per block
-    for block in face_blocks(F):
-        yield block, corner_geometry(*corner_positions(Vt, block))
-
-
-def measured_faces(V, F):
-    """:func:`face_geometry`, with one MeshWarning naming the zero-area faces, if there are any.
-
-    They contribute nothing to the cotangent Laplacian and the vertex areas.
-    """
-    faces = face_geometry(V, F)
-    warn_zero_area(faces[3], stacklevel=4)
-    return faces
-
-
-def measured_areas(V, F):
-    """Twice the area (m,) and the zero-area flag (m,) of every face, as :func:`face_geometry` gives them.
-
-    Measured block by block (:func:`measured_blocks`); warns as :func:`measured_faces` does.
-    """
-    blocks = [faces[1::2] for _, faces in measured_blocks(V, F)]  # keep (dblA, degenerate) only
-    dblA = np.concatenate([b[0] for b in blocks])
-    degenerate = np.concatenate([b[1] for b in blocks])
-    warn_zero_area(degenerate, stacklevel=4)
-    return dblA, degenerate
 
 
 def warn_zero_area(degenerate, stacklevel=3):
@@ -156,7 +169,8 @@ def uniform_laplacian(V, F):
     """(M, C) of the uniform (graph) Laplacian: C_ij = 1 on every edge, C_ii = -valence, M = diag(valence).
 
     C is symmetric, NSD, rows sum to zero; ``M^-1 C x`` is the mean of the
-    neighbours minus ``x_i`` (the "umbrella" operator, Taubin 1995). No metric:
+    neighbours minus ``x_i`` (the weights of Taubin 1995; the name "umbrella" operator is Kobbelt et
+    al. 1998's). No metric:
     zero-area faces count like any other.
 
     Returns
@@ -165,7 +179,11 @@ def uniform_laplacian(V, F):
     C : (n, n) scipy.sparse CSR float64
     """
     V, F = as_mesh(V, F)
-    n = len(V)
+    return graph_laplacian(len(V), F)
+
+
+def graph_laplacian(n, F):
+    """:func:`uniform_laplacian` of n vertices and checked faces F: ``(diag(valence), C)``."""
     E = edges(F)  # each edge ij once, i < j
     ones = np.ones(len(E))
     adjacency = sp.coo_matrix(
@@ -177,18 +195,41 @@ def uniform_laplacian(V, F):
     return sp.diags(valence), C
 
 
-def cotangent_matrix(V, F, faces=None):
-    """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
+def edge_lengths(V, F):
+    """(m, 3) float64: ``l[f, i]`` is the length of the edge of face f opposite its corner i (length).
 
-    Triangle ``(v0, v1, v2)`` adds ``1/2 cot theta_i`` to the edge ``(j, k)``
-    opposite its corner i. A boundary edge has one triangle, so one angle:
-    ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
-    ``faces``: :func:`face_geometry` of (V, F) when the caller has it already.
-    Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
+    Everything the cotangent Laplacian needs of the geometry (:func:`intrinsic_cotangent_matrix`).
     """
     V, F = as_mesh(V, F)
-    n = len(V)
-    _, _, cot, _ = faces or measured_faces(V, F)
+    return np.sqrt(FaceGeometry.of(V, F).l2)
+
+
+def intrinsic_cotangent_matrix(l, F, n=None, dblA=None):
+    """C (n, n) CSR from the edge lengths alone: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``.
+
+    ``l`` (m, 3): ``l[f, i]`` the length of the edge opposite corner i of face f (:func:`edge_lengths`);
+    ``n``: the vertex count (default ``F.max() + 1``). Heron's formula gives the area A of each face,
+    the law of cosines its corner cotangents ``cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)``; corner
+    i adds ``1/2 cot theta_i`` to the edge (j, k) opposite it, so a boundary edge, with one triangle,
+    gets ``1/2 cot alpha_ij``. C is symmetric, negative semidefinite, rows sum to zero. Zero-area
+    triangles add nothing (MeshWarning). Jacobson's intrinsic ``cotmatrix``; Pinkall and Polthier 1993.
+
+    ``dblA`` (m,): twice the face areas, when the caller has them from the positions. A needle's
+    area is exact from a cross product, while its rounded lengths can make Heron's vanish
+    (sides 1, 1 and 2 for a height of 1e-9): :func:`cotangent_matrix` passes it.
+    """
+    l, F = np.asarray(l, dtype=np.float64), np.asarray(F)
+    n = int(F.max()) + 1 if n is None else n
+    if dblA is None:
+        a, b, c = np.sort(l, axis=1)[:, ::-1].T  # a >= b >= c: Heron in Kahan's order, stable for thin faces
+        A = 0.25 * np.sqrt(np.maximum((a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c)), 0.0))
+    else:
+        A = 0.5 * np.asarray(dblA, dtype=np.float64)
+    l2 = l**2
+    degenerate = is_zero_area(2 * A, l2.max(axis=1))
+    warn_zero_area(degenerate)
+    cot = (l2[:, NEXT] + l2[:, PREV] - l2) / (4 * np.where(degenerate, 1.0, A)[:, None])  # law of cosines / sine
+    cot[degenerate] = 0.0
     index = np.int32 if n < 2**31 - 1 else np.int64
     j, k = F[:, NEXT].T.ravel().astype(index), F[:, PREV].T.ravel().astype(index)  # edge (j, k) opposite i
     w = 0.5 * cot.T.ravel()  # gets 1/2 cot theta_i
@@ -198,16 +239,47 @@ def cotangent_matrix(V, F, faces=None):
     return sp.coo_matrix((np.concatenate([w, w, diagonal]), (rows, cols)), shape=(n, n)).tocsr()
 
 
+def cotangent_matrix(V, F):
+    """C (n, n) CSR: ``C_ij = 1/2 (cot alpha_ij + cot beta_ij)``, ``C_ii = -sum_j C_ij``; NSD.
+
+    :func:`intrinsic_cotangent_matrix` of the mesh's edge lengths, with the face areas from
+    cross products: the cotangents depend on the lengths alone. A boundary edge has one triangle, so one angle:
+    ``C_ij = 1/2 cot alpha_ij``. Zero-area triangles add nothing (MeshWarning).
+    Pinkall and Polthier 1993; Meyer et al. 2003, eq. (8).
+    """
+    V, F = as_mesh(V, F)
+    faces = FaceGeometry.of(V, F)
+    return intrinsic_cotangent_matrix(np.sqrt(faces.l2), F, len(V), faces.dblA)
+
+
 def barycentric_areas(V, F, faces=None):
     """(n,) vertex areas A_i in length^2: a third of the area of every incident triangle.
 
     Zero-area triangles add 0 (MeshWarning), so a vertex in no other triangle
-    has area 0. Sums to the surface area. ``faces`` as in :func:`cotangent_matrix`.
+    has area 0. Sums to the surface area. ``faces``: the :class:`FaceGeometry` of (V, F)
+    when the caller has checked (V, F) and measured it (then no warning: the caller gives it).
     """
-    V, F = as_mesh(V, F)
-    dblA, degenerate = (faces[1], faces[3]) if faces else measured_areas(V, F)
-    third = np.where(degenerate, 0.0, dblA / 6.0)
+    if faces is None:  # a call of its own: its door
+        V, F = as_mesh(V, F)
+        faces = FaceGeometry.of(V, F)
+        warn_zero_area(faces.degenerate)
+    third = np.where(faces.degenerate, 0.0, faces.dblA / 6.0)
     return np.bincount(F.ravel(), np.repeat(third, 3), minlength=len(V))  # to each of the 3 corners
+
+
+def voronoi_pieces(V, F, faces=None):
+    """(m, 3) Voronoi piece of each corner, ``1/8 (|e_j|^2 cot theta_j + |e_k|^2 cot theta_k)``, without the obtuse rule.
+
+    The circumcentric region of corner i inside its triangle, a signed area in length^2: it
+    leaves the triangle when the triangle is obtuse, and is negative at corner i exactly when
+    the other two angles differ by more than 90 degrees (notebook 03, section 2).
+    ``faces`` as in :func:`barycentric_areas`.
+    """
+    if faces is None:
+        V, F = as_mesh(V, F)
+        faces = FaceGeometry.of(V, F)
+    lc = faces.l2 * faces.cot
+    return (lc[:, NEXT] + lc[:, PREV]) / 8.0
 
 
 def mixed_areas(V, F, faces=None):
@@ -221,17 +293,18 @@ def mixed_areas(V, F, faces=None):
     * obtuse at another corner: ``A / 4``.
 
     Sums to the surface area. Zero-area triangles add 0 (MeshWarning).
-    ``faces`` as in :func:`cotangent_matrix`.
+    ``faces`` as in :func:`barycentric_areas`.
     """
-    V, F = as_mesh(V, F)
-    l2, dblA, cot, degenerate = faces or measured_faces(V, F)
-    A = 0.5 * dblA[:, None]
-    lc = l2 * cot
-    voronoi = (lc[:, NEXT] + lc[:, PREV]) / 8.0
-    obtuse = cot < 0  # cot theta < 0 <=> theta > pi/2
+    if faces is None:  # a call of its own: its door
+        V, F = as_mesh(V, F)
+        faces = FaceGeometry.of(V, F)
+        warn_zero_area(faces.degenerate)
+    A = 0.5 * faces.dblA[:, None]
+    voronoi = voronoi_pieces(V, F, faces)
+    obtuse = faces.cot < 0  # cot theta < 0 <=> theta > pi/2
     obtuse_triangle = obtuse.any(axis=1, keepdims=True)
     per_corner = np.where(obtuse_triangle, np.where(obtuse, A / 2.0, A / 4.0), voronoi)
-    per_corner[degenerate] = 0.0
+    per_corner[faces.degenerate] = 0.0
     return np.bincount(F.T.ravel(), per_corner.T.ravel(), minlength=len(V))
 
 
@@ -240,7 +313,7 @@ def vertex_areas(V, F, area="barycentric", faces=None):
 
     ``area="barycentric"``: :func:`barycentric_areas`; ``"mixed"``:
     :func:`mixed_areas` (Meyer et al. 2003). Both sum to the surface area.
-    ``faces`` as in :func:`cotangent_matrix`.
+    ``faces`` as in :func:`barycentric_areas`.
     """
     check_options(area=area)
     return (barycentric_areas if area == "barycentric" else mixed_areas)(V, F, faces)
@@ -282,15 +355,21 @@ def laplacian(V, F, weights="cotan", area="barycentric"):
     """
     check_options(weights, area)
     V, F = as_mesh(V, F)
+    return assemble_laplacian(V, F, weights, area)
+
+
+def assemble_laplacian(V, F, weights="cotan", area="barycentric"):
+    """:func:`laplacian` of a checked mesh ((V, F) as ``as_mesh`` returns them, options checked)."""
     if weights == "uniform":
-        return uniform_laplacian(V, F)
-    faces = measured_faces(V, F)  # once for both matrices; names the zero-area faces, if any
-    return sp.diags(vertex_areas(V, F, area, faces)), cotangent_matrix(V, F, faces)
+        return graph_laplacian(len(V), F)
+    faces = FaceGeometry.of(V, F)  # once for both matrices
+    C = intrinsic_cotangent_matrix(np.sqrt(faces.l2), F, len(V), faces.dblA)  # names the zero-area faces, if any
+    return sp.diags(vertex_areas(V, F, area, faces)), C
 
 
 def uniform_adjacency(n, F):
     """Adjacency matrix (n, n) CSR float64 with 1 for every edge ij (each edge once, both directions)."""
-    M, C = uniform_laplacian(np.zeros((n, 3)), F)
+    M, C = graph_laplacian(n, as_faces(F, n))
     A = (C + M).tocsr()
     A.eliminate_zeros()
     return A

@@ -12,7 +12,7 @@ volume are signed fractions, ``(X - X_clean) / |X_clean|``.
 Each metric is one function taking the arrays. :class:`MeshComparison`
 holds one clean mesh and its properties (diagonal, closedness, sharp edges)
 and calls the same functions. The smoothing sweep of notebook 07 that uses
-them is :mod:`geomlib.teaching.sweep`; the elementary measurements (area, volume,
+them is :mod:`geomlib.teaching.experiments.sweep`; the elementary measurements (area, volume,
 bounding-box diagonal, mean edge length) are :mod:`geomlib.mesh.geometry`'s.
 
 Degenerate and special cases are stated where they are handled:

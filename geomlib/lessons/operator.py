@@ -4,7 +4,7 @@ Notebooks 05 and 06 step ``P' = P + tau M^-1 C P`` and solve ``(M - tau C) P' = 
 many times with one operator. :class:`LaplaceOperator` holds what every step,
 step limit and fixed point of one mesh needs; :func:`laplace_operator` builds it
 on first use and keeps the last ``CACHE_SIZE`` in memory under one key,
-:func:`geomlib.numerics.cache.key` of the mesh's bytes and the options (for
+:func:`geomlib.numerics.eigenbasis_store.key` of the mesh's bytes and the options (for
 uniform weights of F and the vertex count only: that operator does not depend on
 the positions, so every noisy copy of a mesh shares it). So a smoother, a step
 limit and a slider on the same mesh assemble it once.
@@ -27,16 +27,16 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ..mesh.errors import MeshError
-from ..mesh.requirements import positive_vertex_areas
 from ..mesh.topology import boundary_vertices
 from ..mesh.validate import as_mesh, check_choice
-from ..numerics import cache
+from ..numerics import eigenbasis_store as cache
 from ..numerics.eigen import largest_eigenpair, largest_eigenvalue
 from ..numerics.factor import factor_seconds, factorise
 from ..numerics.progress import Stages
-from .laplace import check_options, laplacian
+from .laplace import assemble_laplacian, check_options
+from .requirements import positive_vertex_areas
 
-__all__ = ["LaplaceOperator", "laplace_operator", "BOUNDARY_CONDITIONS", "SOLVERS", "CACHE_SIZE"]
+__all__ = ["LaplaceOperator", "laplace_operator", "kept_operator", "BOUNDARY_CONDITIONS", "SOLVERS", "CACHE_SIZE"]
 
 BOUNDARY_CONDITIONS = ("fixed", "free")
 
@@ -57,10 +57,15 @@ def laplace_operator(V, F, weights="cotan", area="barycentric", boundary_conditi
     check_options(weights, area)
     check_choice("boundary_condition", boundary_condition, BOUNDARY_CONDITIONS)
     V, F = as_mesh(V, F)
+    return kept_operator(V, F, weights, area, boundary_condition)
+
+
+def kept_operator(V, F, weights="cotan", area="barycentric", boundary_condition="fixed"):
+    """:func:`laplace_operator` of a checked mesh ((V, F) as ``as_mesh`` returns them, options checked)."""
     # the uniform operator is combinatorial (valences and edges): one per F, whatever the positions
     shape = V if weights == "cotan" else len(V)
     name = cache.key(shape, F, weights, area if weights == "cotan" else None, boundary_condition)
-    L = _OPERATORS.pop(name, None) or LaplaceOperator(V, F, weights, area, boundary_condition)
+    L = _OPERATORS.pop(name, None) or LaplaceOperator.of(V, F, weights, area, boundary_condition)
     _OPERATORS[name] = L  # most recently used last
     while len(_OPERATORS) > CACHE_SIZE:
         _OPERATORS.popitem(last=False)
@@ -85,13 +90,28 @@ class LaplaceOperator:
         M and C with the fixed vertices' rows replaced by ``P'_B = P_B`` (``M_BB = 1``,
         ``C_B* = 0``); M and C themselves when nothing is fixed. The steps of notebooks 05
         and 06 take these.
+
+    ``operator=(M, C)``: a pair built already (signs and shapes of :func:`geomlib.laplacian`),
+    taken instead of assembling one from V, as trimesh's smoothers take a Laplacian operator;
+    ``weights`` and ``area`` then only name it.
     """
 
-    def __init__(self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed"):
+    def __init__(self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed", *, operator=None):
+        check_options(weights, area)
         check_choice("boundary_condition", boundary_condition, BOUNDARY_CONDITIONS)
         V, F = as_mesh(V, F)
+        self._build(V, F, weights, area, boundary_condition, operator)
+
+    @classmethod
+    def of(cls, V, F, weights="cotan", area="barycentric", boundary_condition="fixed", operator=None):
+        """The operator of a checked mesh ((V, F) as ``as_mesh`` returns them, options checked)."""
+        L = cls.__new__(cls)
+        L._build(V, F, weights, area, boundary_condition, operator)
+        return L
+
+    def _build(self, V, F, weights, area, boundary_condition, operator):
         self.weights, self.area, self.boundary_condition = weights, area, boundary_condition
-        self.M, C = laplacian(V, F, weights=weights, area=area)
+        self.M, C = assemble_laplacian(V, F, weights, area) if operator is None else pair(operator, len(V))
         self.C = C.tocsr()
         self.m = self.M.diagonal()
         self.moving = np.ones(len(V), dtype=bool)
@@ -178,3 +198,22 @@ class LaplaceOperator:
             return X
 
         return solve
+
+
+def pair(operator, n=None):
+    """``(M, C)`` of a built operator handed to a smoother or a solve, as (DIA, CSR) matrices.
+
+    Raises MeshError unless it is a pair of square matrices of one size (n, when given) and M is diagonal.
+    """
+    try:
+        M, C = operator
+    except (TypeError, ValueError):
+        raise MeshError("the operator must be a pair (M, C) as geomlib.laplacian returns it") from None
+    M, C = sp.csr_matrix(M), sp.csr_matrix(C)
+    size = M.shape[0] if n is None else n
+    if M.shape != (size, size) or C.shape != (size, size):
+        raise MeshError(f"M and C must be square and of one size ({size}): M is {M.shape}, C is {C.shape}")
+    m = M.diagonal()
+    if abs(M - sp.diags(m)).max() > 0:
+        raise MeshError("M must be diagonal (the lumped vertex areas): its off-diagonal entries are not all zero")
+    return sp.diags(m), C

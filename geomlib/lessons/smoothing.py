@@ -43,12 +43,13 @@ import numpy as np
 
 from ..mesh.errors import MeshError, MeshWarning, format_indices
 from ..mesh.geometry import bounding_box_diagonal, surface_area, volume_and_centroid
-from ..mesh.requirements import positive_vertex_areas
 from ..mesh.topology import boundary_vertices
 from ..mesh.validate import as_mesh, check_choice
 from ..numerics.factor import factorise
 from ..numerics.progress import Iterations
-from .operator import SOLVERS, LaplaceOperator, laplace_operator
+from .laplace import check_options
+from .operator import BOUNDARY_CONDITIONS, SOLVERS, LaplaceOperator, kept_operator, laplace_operator
+from .requirements import positive_vertex_areas
 
 __all__ = [
     "explicit_step",
@@ -176,8 +177,9 @@ def fixed_point(V, F, weights="cotan", area="barycentric"):
     -------
     P_star : (n, 3) float64, length units.
     """
+    check_options(weights, area)
     V, F = as_mesh(V, F)
-    L = laplace_operator(V, F, weights, area, "fixed")
+    L = kept_operator(V, F, weights, area, "fixed")
     if len(L.B) == 0:
         return np.repeat([L.m @ V / L.m.sum()], len(V), axis=0)
     C_II, C_IB = L.blocks
@@ -212,12 +214,35 @@ def _check_iterations(iterations):
 
 
 def _tau_or_step(tau, step):
-    """``tau``, or ``step``, the name DESIGN.md's contract gives the same argument."""
+    """``tau``, or ``step``, the same argument under the name of the course's interface
+    (``explicit_smoothing(V, F, step, iterations)``), kept for callers that pass it by that name."""
     if step is None:
         return tau
     if tau is not None:
         raise MeshError("give the step once, as tau (step is the same argument)")
     return step
+
+
+def smoothing_operator(V, F, weights, area, boundary_condition, operator=None):
+    """The door of a smoothing call: ``(V, F, L)``, the mesh checked once and its :class:`LaplaceOperator`.
+
+    ``operator=(M, C)``: that pair with the boundary condition (not kept in memory); else the
+    operator of the mesh and options, built once and kept (:func:`kept_operator`).
+    """
+    check_options(weights, area)
+    check_choice("boundary_condition", boundary_condition, BOUNDARY_CONDITIONS)
+    V, F = as_mesh(V, F)
+    if operator is None:
+        return V, F, kept_operator(V, F, weights, area, boundary_condition)
+    return V, F, LaplaceOperator.of(V, F, weights, area, boundary_condition, operator)
+
+
+def _done(k, P, callback, bar):
+    """Iteration k of a smoothing run is done with the positions P: tell ``callback`` and the progress bar."""
+    if callback is not None:
+        callback(k, P)
+    bar.step(k)
+    return P
 
 
 def _fail(on_failure, message, k, P_last, stacklevel=3):
@@ -237,20 +262,11 @@ def _fail(on_failure, message, k, P_last, stacklevel=3):
 
 
 def explicit_smoothing(
-    V,
-    F,
-    tau=None,
-    iterations=1,
-    weights="cotan",
-    *,
-    step=None,
-    step_fraction=None,
-    area="barycentric",
-    boundary_condition="fixed",
-    progress=None,
-    callback=None,
-    on_failure="raise",
-):
+    V, F, tau=None, iterations=1, weights="cotan", *,
+    step=None, step_fraction=None,  # the step, in another name or unit
+    area="barycentric", boundary_condition="fixed", operator=None,  # the operator
+    progress=None, callback=None, on_failure="raise",  # the run
+):  # fmt: skip
     """Explicit Laplacian smoothing: ``P <- P + tau M^-1 C P``, repeated ``iterations`` times.
 
     Forward Euler on the heat flow ``dP/dt = Delta P`` with ``Delta = M^-1 C``
@@ -269,11 +285,15 @@ def explicit_smoothing(
     iterations : int >= 0
     weights : "cotan" or "uniform"
     step : float >= 0, optional
-        Another name for ``tau`` (the one DESIGN.md's contract uses).
+        Another name for ``tau``, the course's name for it (``explicit_smoothing(V, F, step=..., iterations=...)``).
     step_fraction : float >= 0, optional
         The step as a fraction of the stability limit (scale-free): below 1 is stable.
     area : "barycentric" or "mixed"
     boundary_condition : "fixed" (default) or "free"
+    operator : (M, C), optional
+        A pair built already from (V, F) (:func:`geomlib.laplacian`), stepped instead of
+        assembling one, as trimesh's smoothers take a Laplacian operator; ``weights`` and
+        ``area`` then only name it.
     progress : None, True or False
         Progress bar (tqdm.auto); None: shown when the first iteration predicts
         more than ``geomlib.numerics.progress.SECONDS``.
@@ -304,7 +324,7 @@ def explicit_smoothing(
     References: Taubin 1995; Desbrun, Meyer, Schroeder and Barr 1999.
     """
     # _smooth, not smooth: the warnings then name the caller of explicit_smoothing
-    return ExplicitSmoother(V, F, weights, area, boundary_condition)._smooth(
+    return ExplicitSmoother(V, F, weights, area, boundary_condition, operator=operator)._smooth(
         _tau_or_step(tau, step), iterations, step_fraction, progress, callback, on_failure
     )
 
@@ -320,7 +340,7 @@ class ExplicitSmoother:
 
     Parameters
     ----------
-    V, F, weights, area, boundary_condition : as in :func:`explicit_smoothing`.
+    V, F, weights, area, boundary_condition, operator : as in :func:`explicit_smoothing`.
 
     Raises
     ------
@@ -328,9 +348,8 @@ class ExplicitSmoother:
         Bad mesh or option; vertices with zero area (named).
     """
 
-    def __init__(self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed"):
-        self.V, self.F = as_mesh(V, F)
-        self.L = laplace_operator(self.V, self.F, weights, area, boundary_condition)
+    def __init__(self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed", *, operator=None):
+        self.V, self.F, self.L = smoothing_operator(V, F, weights, area, boundary_condition, operator)
         self.L.require_positive_areas(self.F, "explicit_smoothing")
 
     def smooth(self, tau=None, iterations=1, *, step_fraction=None, progress=None, callback=None, on_failure="raise"):
@@ -356,10 +375,7 @@ class ExplicitSmoother:
                         f"{tau:.6g}): coordinates left {BLOWUP_FACTOR:g} bounding-box diagonals"
                     )
                     return _fail(on_failure, message, k, P, stacklevel=4)
-                P = P_next
-                if callback is not None:
-                    callback(k, P)
-                bar.step(k)
+                P = _done(k, P_next, callback, bar)
         finally:
             bar.close()
         return P
@@ -418,7 +434,7 @@ class ImplicitSmoother:
 
     Parameters
     ----------
-    V, F, weights, area, boundary_condition : as in :func:`implicit_smoothing`.
+    V, F, weights, area, boundary_condition, operator : as in :func:`implicit_smoothing`.
     cache_size : int
         How many factorisations to keep.
     history_size : int
@@ -426,10 +442,18 @@ class ImplicitSmoother:
     """
 
     def __init__(
-        self, V, F, weights="cotan", area="barycentric", boundary_condition="fixed", cache_size=16, history_size=4
+        self,
+        V,
+        F,
+        weights="cotan",
+        area="barycentric",
+        boundary_condition="fixed",
+        cache_size=16,
+        history_size=4,
+        *,
+        operator=None,
     ):
-        self.V, self.F = as_mesh(V, F)
-        self.L = laplace_operator(self.V, self.F, weights, area, boundary_condition)
+        self.V, self.F, self.L = smoothing_operator(V, F, weights, area, boundary_condition, operator)
         self.L.require_positive_areas(self.F, "ImplicitSmoother")
         self.cache_size, self.history_size = int(cache_size), int(history_size)
         self._factors, self._history = {}, {}
@@ -543,7 +567,7 @@ def _rebuilt_step(P, F, weights, area, boundary_condition, tau, k):
     with warnings.catch_warnings():
         warnings.simplefilter("error", MeshWarning)
         try:
-            L = LaplaceOperator(P, F, weights, area, boundary_condition)  # of P, so not kept in memory
+            L = LaplaceOperator.of(P, F, weights, area, boundary_condition)  # of P, so not kept in memory
             L.require_positive_areas(F, "implicit_smoothing")
             return implicit_step(P, L.M_step, L.C_step, tau, L.step_solver(tau))
         except (MeshWarning, MeshError) as exc:  # degenerate triangles, M - tau C singular
@@ -551,22 +575,11 @@ def _rebuilt_step(P, F, weights, area, boundary_condition, tau, k):
 
 
 def implicit_smoothing(
-    V,
-    F,
-    tau=None,
-    iterations=1,
-    weights="cotan",
-    *,
-    step=None,
-    area="barycentric",
-    boundary_condition="fixed",
-    rebuild=False,
-    keep_volume=False,
-    solver="cholesky",
-    progress=None,
-    callback=None,
-    on_failure="raise",
-):
+    V, F, tau=None, iterations=1, weights="cotan", *,
+    step=None,  # the step in another name
+    area="barycentric", boundary_condition="fixed", operator=None, rebuild=False,  # the operator
+    keep_volume=False, solver="cholesky", progress=None, callback=None, on_failure="raise",  # the run
+):  # fmt: skip
     """Implicit Laplacian smoothing: solve ``(M - tau C) P' = M P``, repeated.
 
     Backward Euler on ``dP/dt = Delta P``, ``Delta = M^-1 C`` (C symmetric
@@ -585,11 +598,13 @@ def implicit_smoothing(
     iterations : int >= 0
     weights : "cotan" or "uniform"
     step : float >= 0, optional
-        Another name for ``tau`` (the one DESIGN.md's contract uses).
+        Another name for ``tau``, the course's name for it (``implicit_smoothing(V, F, step=..., iterations=...)``).
     area : "barycentric" or "mixed"
     boundary_condition : "fixed" (default) or "free"
         Fixed: boundary vertices keep their positions and the interior block
         ``(M_II - tau C_II) P'_I = M_I P_I + tau C_IB P_B`` is solved.
+    operator : (M, C), optional
+        As in :func:`explicit_smoothing`; not with ``rebuild``.
     rebuild : bool
         False (default): the operator of V is kept and factorised once. True: M
         and C are rebuilt from the current positions every iteration (implicit
@@ -618,21 +633,16 @@ def implicit_smoothing(
         non-finite result: raise MeshError (with ``.V``, the last valid
         positions, and ``.iteration``) or warn (MeshWarning) and return them.
 
-    Returns
-    -------
-    (n, 3) float64
-
-    Raises
-    ------
-    MeshError
-        Bad tau, iterations or option; vertices with zero area; keep_volume
-        on an open mesh; a failure (above) with ``on_failure="raise"``.
+    Returns the new positions, (n, 3) float64. Raises MeshError for a bad tau, iterations or
+    option, vertices with zero area, keep_volume on an open mesh, or a failure (above) with
+    ``on_failure="raise"``.
     """
-    V, F = as_mesh(V, F)
     tau, iterations = _check_tau(_tau_or_step(tau, step)), _check_iterations(iterations)
     check_choice("solver", solver, SOLVERS)
     check_choice("on_failure", on_failure, ON_FAILURE)
-    L = laplace_operator(V, F, weights, area, boundary_condition)
+    if rebuild and operator is not None:
+        raise MeshError("rebuild=True assembles the operator from the current positions: give no operator")
+    V, F, L = smoothing_operator(V, F, weights, area, boundary_condition, operator)
     L.require_positive_areas(F, "implicit_smoothing")
     keeper = _VolumeKeeper(V, F) if keep_volume else None
     if not rebuild and (iterations == 0 or tau == 0):
@@ -661,10 +671,7 @@ def implicit_smoothing(
                     k,
                     P,
                 )
-            P = P_next
-            if callback is not None:
-                callback(k, P)
-            bar.step(k)
+            P = _done(k, P_next, callback, bar)
     finally:
         bar.close()
     return P

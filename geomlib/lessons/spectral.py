@@ -22,7 +22,7 @@ meshes, block Lanczos on one sparse Cholesky factorisation otherwise).
 
 Cache (:func:`spectral_basis`, a separate entry that calls :func:`eigenbasis`
 on a miss): a basis is kept in memory (the last few meshes) and on disk
-(:mod:`geomlib.numerics.cache`), so a slider over ``k`` re-projects without
+(:mod:`geomlib.numerics.eigenbasis_store`), so a slider over ``k`` re-projects without
 solving again and a restarted kernel finds it. ``cache=False`` neither reads
 nor writes it; :func:`clear_spectral_cache` empties it;
 :func:`spectral_cache_dir` says where it is.
@@ -36,11 +36,12 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.requirements import positive_vertex_areas
 from ..mesh.validate import as_mesh
-from ..numerics import cache as basis_cache
+from ..numerics import eigenbasis_store as basis_cache
 from ..numerics.eigen import one_blas_thread, smallest_eigenpairs
-from .laplace import laplacian, uniform_laplacian, vertex_areas
+from .laplace import assemble_laplacian, check_options
+from .operator import pair
+from .requirements import positive_vertex_areas
 
 __all__ = [
     "eigenbasis",
@@ -48,6 +49,7 @@ __all__ = [
     "spectral_reconstruction",
     "SpectralBasis",
     "spectral_basis",
+    "stored_basis",
     "spectral_cache_dir",
     "clear_spectral_cache",
 ]
@@ -55,7 +57,7 @@ __all__ = [
 _METHODS = {"auto": "auto", "dense": "dense", "sparse": "sparse", "arpack": "sparse"}
 
 
-def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", tol=1e-10):
+def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", tol=1e-10, operator=None):
     """The k smallest eigenpairs of ``C e = -lam M e``: ``lam`` ascending >= 0, ``E^T M E = I``.
 
     ``(M, C) = laplacian(V, F, weights, area)``, so ``Delta e_i = -lam_i e_i``.
@@ -80,6 +82,10 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
     tol : float
         Relative residual of the sparse solve, ``||Q z - lam z|| <= tol ||Q||``
         (:func:`geomlib.numerics.eigen.smallest_eigenpairs`).
+    operator : (M, C), optional
+        A pair built already from this (V, F) (:func:`geomlib.laplacian`), solved instead of
+        assembling one, as trimesh's smoothers take a Laplacian operator; (V, F) are then
+        taken as checked and ``weights`` and ``area`` are not used.
 
     Returns
     -------
@@ -112,9 +118,12 @@ def eigenbasis(V, F, k, weights="cotan", area="barycentric", *, method="auto", t
     gives the natural (Neumann) boundary condition, so the constant is still
     the first eigenvector.
     """
-    V, F = as_mesh(V, F)
+    if operator is None:  # a call of its own: its door
+        check_options(weights, area)
+        V, F = as_mesh(V, F)
+        operator = assemble_laplacian(V, F, weights, area)
+    M, C = pair(operator, len(V))
     k, method = _check_k(k, len(V)), _check_method(method)
-    M, C = laplacian(V, F, weights=weights, area=area)
     positive_vertex_areas(M, F, "eigenbasis")  # names the vertices without area, and the call that removes them
     return eigenpairs(M, C, k, method=method, tol=tol)
 
@@ -146,7 +155,7 @@ def eigenpairs(M, C, k, *, method="auto", tol=1e-10):
     MeshError
         M or C not (n, n), M not diagonal or with an entry <= 0, k outside 1..n, unknown method.
     """
-    M, C = _square_pair(M, C)
+    M, C = pair((M, C))
     m = positive_vertex_areas(M, None, "eigenpairs")
     k, method = _check_k(k, len(m)), _check_method(method)
     D_inv = sp.diags(1.0 / np.sqrt(m))  # M^-1/2
@@ -157,16 +166,6 @@ def eigenpairs(M, C, k, *, method="auto", tol=1e-10):
     lam, Z = smallest_eigenpairs(Q.tocsr(), k, shift, _METHODS[method], tol, null=Z0)
     E = D_inv @ Z  # e = M^-1/2 z, so E^T M E = Z^T Z = I
     return _tidy(lam, E, m, count, labels)
-
-
-def _square_pair(M, C):
-    M, C = sp.csr_matrix(M), sp.csr_matrix(C)
-    n = M.shape[0]
-    if M.shape != (n, n) or C.shape != (n, n):
-        raise MeshError(f"M and C must be square and of one size: M is {M.shape}, C is {C.shape}")
-    if abs(M - sp.diags(M.diagonal())).max() > 0:
-        raise MeshError("M must be diagonal (the lumped vertex areas): its off-diagonal entries are not all zero")
-    return M, C
 
 
 def _check_k(k, n):
@@ -326,14 +325,20 @@ def spectral_basis(
     """:func:`eigenbasis` behind a cache, as a :class:`SpectralBasis`.
 
     The basis of a mesh and its options is kept in memory (the last few) and
-    on disk (:mod:`geomlib.numerics.cache`, under :func:`spectral_cache_dir`
+    on disk (:mod:`geomlib.numerics.eigenbasis_store`, under :func:`spectral_cache_dir`
     or ``cache_dir``), so asking again, with any k up to the stored one, or
     after a kernel restart, does not solve. ``cache=False`` neither reads nor
     writes it. ``basis.reconstruct(X, j)`` then projects per-vertex values X
     onto the first j <= k eigenvectors (what a slider over k needs);
     ``basis.residual_norms(X)`` gives the error for every j at once.
     """
+    check_options(weights, area)
     V, F = as_mesh(V, F)
+    return stored_basis(V, F, k, weights, area, cache, cache_dir, method, tol)
+
+
+def stored_basis(V, F, k, weights, area, cache=True, cache_dir=None, method="auto", tol=1e-10):
+    """:func:`spectral_basis` of a checked mesh ((V, F) as ``as_mesh`` returns them, options checked)."""
     k, _ = _check_k(k, len(V)), _check_method(method)
     name, folder = basis_cache.key(V, F, "eigenbasis", weights, area), spectral_cache_dir(cache_dir)
     kept = basis_cache.recall(name) if cache else None
@@ -344,9 +349,10 @@ def spectral_basis(
         basis = SpectralBasis(*stored, source="disk")
     else:
         t0 = time.perf_counter()
-        lam, E = eigenbasis(V, F, k, weights, area, method=method, tol=tol)
+        M, C = assemble_laplacian(V, F, weights, area)
+        lam, E = eigenbasis(V, F, k, weights, area, method=method, tol=tol, operator=(M, C))
         seconds = time.perf_counter() - t0
-        m = uniform_laplacian(V, F)[0].diagonal() if weights == "uniform" else vertex_areas(V, F, area)
+        m = M.diagonal()
         basis = SpectralBasis(lam, E, m, seconds)
         if cache:
             basis_cache.store(folder, name, lam, basis.E, m)
@@ -368,12 +374,13 @@ def spectral_reconstruction(V, F, k, weights="cotan", area="barycentric", *, cac
     -------
     V_k : (n, 3) float64, in the units of V.
     """
+    check_options(weights, area)
     V, F = as_mesh(V, F)
-    return spectral_basis(V, F, k, weights, area, cache=cache, cache_dir=cache_dir, method=method).reconstruct(V)
+    return stored_basis(V, F, k, weights, area, cache, cache_dir, method).reconstruct(V)
 
 
 def spectral_cache_dir(cache_dir=None):
-    """The folder holding cached eigenbases (it need not exist yet); see :func:`geomlib.numerics.cache.folder`."""
+    """The folder holding cached eigenbases (it need not exist yet); see :func:`geomlib.numerics.eigenbasis_store.folder`."""
     return basis_cache.folder(cache_dir)
 
 

@@ -68,6 +68,8 @@ __all__ = [
     "ellipsoid",
     "ellipsoid_forms",
     "ellipsoid_normal_curvature",
+    "forms_normal_curvature",
+    "unit_tangent",
     "sphere",
     "torus",
     "helicoid",
@@ -798,23 +800,58 @@ def ellipsoid_forms(a, b, c, u, v):
     return I.subs(at, simultaneous=True), II.subs(at, simultaneous=True)
 
 
+def unit_tangent(E, F, G, phi):
+    """(du, dv): the unit tangent t = du p_u + dv p_v at angle ``phi`` (radians) from p_u, towards p_v.
+
+    ``t = cos phi p_u / |p_u| + sin phi w`` with ``w`` the unit tangent perpendicular to p_u on the side
+    of p_v (module docstring). From I alone: ``|p_u| = sqrt(E)``, ``|p_u x p_v| = sqrt(EG - F^2)`` and
+    ``w = (E p_v - F p_u) / (sqrt(E) sqrt(EG - F^2))`` (then ``w . p_u = 0``, ``w . p_v > 0``, ``|w| = 1``).
+    Numbers or numpy arrays; where F = 0 it is (cos phi / sqrt(E), sin phi / sqrt(G)).
+    """
+    root_E, area = np.sqrt(E), np.sqrt(E * G - F**2)
+    return np.cos(phi) / root_E - np.sin(phi) * F / (root_E * area), np.sin(phi) * root_E / area
+
+
 def ellipsoid_normal_curvature(a, b, c, phi, u=0.0, v=math.pi / 2):
     """kappa_n(phi) = II(t, t) of ``ellipsoid(a, b, c)`` at (u, v), by default the point (a, 0, 0), in 1/length.
 
     ``t`` is the unit tangent at angle ``phi`` (radians) from p_u, towards p_v
-    (module docstring), written in coordinates (du, dv): t = du p_u + dv p_v with
+    (:func:`unit_tangent`), written in coordinates (du, dv): t = du p_u + dv p_v with
     I(t, t) = 1. At (a, 0, 0), I = diag(b^2, c^2), II = diag(a, a) and
     (du, dv) = (cos phi / b, sin phi / c), so kappa_n = a cos^2 phi / b^2 + a sin^2 phi / c^2.
     Numbers or numpy arrays in, float64 out (the forms are compiled once per family).
     """
     ell = ellipsoid(a, b, c)
     I, II = ell.lambdify("first_fundamental_form")(u, v), ell.lambdify("second_fundamental_form")(u, v)
-    E, F, G = I[..., 0, 0], I[..., 0, 1], I[..., 1, 1]
-    root_E, area = np.sqrt(E), np.sqrt(E * G - F**2)
-    # t = cos phi p_u / |p_u| + sin phi w, with w = (E p_v - F p_u) / (sqrt(E) area) the unit tangent normal to p_u
-    du = np.cos(phi) / root_E - np.sin(phi) * F / (root_E * area)
-    dv = np.sin(phi) * root_E / area
+    du, dv = unit_tangent(I[..., 0, 0], I[..., 0, 1], I[..., 1, 1], phi)
     return II[..., 0, 0] * du**2 + 2 * II[..., 0, 1] * du * dv + II[..., 1, 1] * dv**2
+
+
+def forms_normal_curvature(forms, a, b, c, u, v, phi):
+    """kappa_n(phi) = II(t, t) / I(t, t) at p(u, v), from the fundamental forms ``forms`` derives, in 1/length.
+
+    ``forms(a, b, c, u, v)`` returns ``E, F, G, e, f, g`` (or the pair of 2x2 matrices ``I, II``) as
+    sympy expressions in the symbols it is given, like notebook 02's exercise and :func:`ellipsoid_forms`:
+    the surface's forms, with ``e, f, g`` taken against -n (module docstring). They are evaluated at the
+    numbers ``a, b, c, u, v``; ``t`` is the unit tangent at angle ``phi`` (radians, a number or an
+    array) from p_u towards p_v (:func:`unit_tangent`). Notebook 02 feeds it the learner's own forms.
+    """
+    E, F, G, e, f, g = (float(x) for x in _forms_at(forms, (a, b, c, u, v)))
+    du, dv = unit_tangent(E, F, G, phi)
+    II_tt = e * du**2 + 2 * f * du * dv + g * dv**2
+    I_tt = E * du**2 + 2 * F * du * dv + G * dv**2  # 1 up to rounding: t is a unit vector
+    return II_tt / I_tt
+
+
+def _forms_at(forms, values):
+    """The six coefficients E, F, G, e, f, g of ``forms`` (6 expressions, or the matrices I, II) at ``values``."""
+    symbols = sp.symbols("a b c u v", real=True)
+    out = forms(*symbols)
+    if len(out) == 2:
+        I, II = (sp.Matrix(X) for X in out)
+        out = (I[0, 0], I[0, 1], I[1, 1], II[0, 0], II[0, 1], II[1, 1])
+    at = dict(zip(symbols, (sp.Float(x) for x in values)))
+    return [sp.sympify(x).evalf(subs=at) for x in out]
 
 
 @functools.lru_cache(maxsize=None)

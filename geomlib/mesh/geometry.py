@@ -19,6 +19,7 @@ __all__ = [
     "face_normals",
     "zero_area_faces",
     "vertex_normals",
+    "area_weighted_normals",
     "surface_area",
     "face_volumes",
     "enclosed_volume",
@@ -101,6 +102,11 @@ def vertex_normals(V, F):
     face of non-zero area has no normal: its row is (0, 0, 0), not NaN.
     """
     V, F = as_mesh(V, F)
+    return area_weighted_normals(V, F)
+
+
+def area_weighted_normals(V, F):
+    """:func:`vertex_normals` of a checked mesh ((V, F) as ``validate.as_mesh`` returns them)."""
     v0, v1, v2 = corner_positions(V, F)
     N2 = cross(v1 - v0, v2 - v0)  # (3, m) coordinate rows of 2 A_f n_f
     corners = F.T.ravel()  # corner by corner, matching np.tile of each row

@@ -191,14 +191,7 @@ def check_mesh(V, F):
       faces; genus ``g = (2 - chi - b) / 2`` with ``b`` boundary loops, given
       only for a connected, manifold, consistently oriented mesh.
 
-    Parameters
-    ----------
-    V : (n, 3) float64
-    F : (m, 3) int64
-
-    Returns
-    -------
-    MeshReport
+    V (n, 3) float64 and F (m, 3) int64 are the mesh; returns a :class:`MeshReport`.
     """
     V, F = as_mesh(V, F)
     n, m = len(V), len(F)
@@ -215,7 +208,7 @@ def check_mesh(V, F):
     loops = loops_from_edges(bedges) if len(bedges) else []
     unref = np.flatnonzero(T.vertex_face_count == 0)
     dups = T.duplicate_faces()
-    chi = int(n - len(unref) - len(T.E) + m)
+    chi = T.euler_characteristic()
     genus = None
     if n_comp == 1 and len(nm_edges) == 0 and len(nm_vertices) == 0 and len(inconsistent) == 0:
         g2 = 2 - chi - len(loops)

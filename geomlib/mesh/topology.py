@@ -103,6 +103,10 @@ class Topology:
         p = self.group_start[self.edge_face_count == 1]
         return np.sort(self.order[p])
 
+    def euler_characteristic(self):
+        """``chi = V - E + F``, V counting only the vertices some face uses."""
+        return int(np.count_nonzero(self.vertex_face_count)) - len(self.E) + len(self.F)
+
     def boundary_edges(self):
         h = self.boundary_halfedges()
         return np.stack([self.I[h], self.J[h]], axis=1)
@@ -513,9 +517,7 @@ def euler_characteristic(V, F):
     int
     """
     V, F = as_mesh(V, F)
-    T = Topology(F, len(V))
-    used = int(np.count_nonzero(T.vertex_face_count))
-    return used - len(T.E) + len(F)
+    return Topology(F, len(V)).euler_characteristic()
 
 
 def connected_components(F, n=None):

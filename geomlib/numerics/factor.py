@@ -38,7 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 from cholespy import CholeskySolverD, MatrixType
 
-from . import cache
+from . import eigenbasis_store as cache
 
 __all__ = ["Factor", "factorise", "factor_seconds", "forget_factorisations", "CACHE_SIZE"]
 

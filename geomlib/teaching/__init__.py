@@ -1,6 +1,9 @@
 """Teaching aids: 3D views and stills, exercise checks, notebook helpers, experiment drivers.
 
-May import every other layer; no other layer imports it.
+May import the mesh core, numerics and lessons; only the course tools import it. Its parts:
+``shapes/`` (the exact surfaces tests and checks rely on), ``experiments/`` (the step unit,
+the sweeps of notebook 07), ``display/`` (views, stills, controls), ``figures/`` (the
+notebooks' matplotlib figures), ``check/`` (exercise checks), ``notebook`` (claims, notes).
 
 The names a lesson notebook uses are importable from here, so that a notebook's
 teaching aids come in one line (``from geomlib.teaching import claim, live, MeshView``).
@@ -12,13 +15,20 @@ from importlib import import_module
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
     **dict.fromkeys(["reveal", "use"], "check"),
-    **dict.fromkeys(["live", "mesh_warnings"], "controls"),
+    **dict.fromkeys(["live", "mesh_warnings"], "display.controls"),
     **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
-    **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "steps"),
+    **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "experiments.steps"),
     **dict.fromkeys(
-        ["EXPLICIT_FRACTIONS", "IMPLICIT_STEPS", "denoising_comparison", "plot_comparison", "smoothing_sweep"], "sweep"
+        [
+            "EXPLICIT_FRACTIONS",
+            "IMPLICIT_STEPS",
+            "denoising_comparison",
+            "smoothing_sweep",
+        ],
+        "experiments.sweep",
     ),
-    **dict.fromkeys(["MeshView", "side_by_side"], "viewer"),
+    **dict.fromkeys(["MeshView", "setup_display", "side_by_side"], "display.viewer"),
+    **dict.fromkeys(["plot_comparison", "plot_sweep"], "figures.denoising_plots"),
 }
 
 __all__ = sorted(_EXPORTS)

@@ -7,7 +7,7 @@ appendices NNa_*.ipynb run under nbval and as pages of the website, tests/browse
 2. no cell has an error output (stderr text such as tqdm's progress bars is fine);
 3. every 3D view (``.geomlib-canvas``) shows a picture: not one flat colour;
 4. the first slider sharing an ipywidgets box with a view, or else displayed
-   by the same cell as a view (the convention is in geomlib/teaching/viewer.py), is
+   by the same cell as a view (the convention is in geomlib/teaching/display/viewer.py), is
    moved with the keyboard and the picture changes;
 5. where views are shown with ``side_by_side``, an orbit drag in the first one
    also turns the second (linked cameras).
@@ -92,7 +92,7 @@ def test_notebook_in_browser(notebook, browser, lab_server, screenshot_dir):
             return
         assert found["found"], (
             f"{notebook}: no slider shares an ipywidgets box or a cell with a view; put them in one box, "
-            "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/teaching/viewer.py)"
+            "e.g. ipywidgets.VBox([slider, view.widget]), or display both from one cell (see geomlib/teaching/display/viewer.py)"
         )
         box_canvases = page.locator("[data-geomlib-box] .geomlib-canvas")
         before = [lablib.stable_screenshot(box_canvases.nth(i)) for i in range(box_canvases.count())]

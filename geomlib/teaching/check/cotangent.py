@@ -3,11 +3,11 @@
 The small cases have known answers: an irregular tetrahedron (closed, every
 angle different, none right), an irregular triangular bipyramid (closed, valences
 3 and 4, three obtuse triangles), one obtuse triangle (mixed areas A/2, A/4, A/4)
-and a jittered 4 x 4 grid (open, valences 1 to 6, obtuse triangles and boundary
+and a jittered 4 x 4 grid (open, valences 2 to 6, obtuse triangles and boundary
 edges). The reference values come from ``geomlib.lessons.laplace``; the typical
 wrong variants are rebuilt here from the per-corner cotangents
 (``geomlib.lessons.laplace.face_geometry``) so each can be named when it is met.
-Vertex-area mistakes are named by ``geomlib.teaching.check.areas``, in the same
+Vertex-area mistakes are named by ``geomlib.teaching.check.area_mistakes``, in the same
 words as the Gaussian-curvature check of notebook 01.
 """
 
@@ -16,35 +16,20 @@ import numpy as np
 from ...lessons import laplace
 from ...lessons.laplace import barycentric_areas, cotangent_matrix, face_geometry
 from ...mesh.topology import boundary_edges
-from .areas import area_mistake_over
-from .result import Mistake, call, close, exercise, matrix_pair, vector
+from .area_mistakes import area_mistake_over
+from .catalogue import matrix_pair, vector
+from .meshes import irregular_bipyramid, irregular_tetrahedron, jittered_grid_4x4, obtuse_triangle
+from .result import Mistake, call, close, exercise
 
 __all__ = ["cotangent_laplacian", "vertex_areas", "mixed_areas"]
 
 _REREAD_C = "section 1 · Cotangent weights, derived"
 _REREAD_A = "section 2 · Which area? Barycentric and mixed Voronoi"
 
-_TET_V = np.array([[0.0, 0.0, 0.0], [1.3, 0.1, 0.0], [0.4, 1.1, 0.2], [0.3, 0.4, 0.9]])
-_TET_F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
-_BIPYRAMID_V = np.array([[0.0, 0, 0], [2.2, 0.1, 0], [0.5, 1.2, 0.1], [0.9, 0.45, 0.3], [0.7, 0.5, -0.8]])
-_BIPYRAMID_F = np.array([[0, 1, 3], [1, 2, 3], [2, 0, 3], [1, 0, 4], [2, 1, 4], [0, 2, 4]])
-_OBTUSE_V = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [1.0, 1.0, 0.0]])  # obtuse at vertex 2, area 2
-_OBTUSE_F = np.array([[0, 1, 2]])
-
-
-def _jittered_grid():
-    rng = np.random.default_rng(3)
-    V = np.array([[x, y, 0.1 * x * y] for y in range(4) for x in range(4)], dtype=float)
-    V[:, :2] += rng.uniform(-0.3, 0.3, size=(16, 2))
-    F = []
-    for y in range(3):
-        for x in range(3):
-            a = 4 * y + x
-            F += [[a, a + 1, a + 5], [a, a + 5, a + 4]]
-    return V, np.array(F)
-
-
-_GRID_V, _GRID_F = _jittered_grid()
+_TET_V, _TET_F = irregular_tetrahedron()
+_BIPYRAMID_V, _BIPYRAMID_F = irregular_bipyramid()
+_OBTUSE_V, _OBTUSE_F = obtuse_triangle()
+_GRID_V, _GRID_F = jittered_grid_4x4()
 _CASES = (
     ("an irregular tetrahedron", _TET_V, _TET_F),
     ("an irregular bipyramid", _BIPYRAMID_V, _BIPYRAMID_F),
@@ -239,7 +224,6 @@ def _check_areas(fn, asked, reference, hint):
         "lessons.laplace.barycentric_areas",
         "lessons.laplace.vertex_areas",
         "lessons.laplace.laplacian",
-        "lessons.laplace.measured_areas",
     ),
 )
 def vertex_areas(fn):
@@ -256,7 +240,6 @@ def vertex_areas(fn):
         "lessons.laplace.mixed_areas",
         "lessons.laplace.vertex_areas",
         "lessons.laplace.laplacian",
-        "lessons.laplace.measured_areas",
     ),
 )
 def mixed_areas(fn):

@@ -27,9 +27,10 @@ from pathlib import Path
 import numpy as np
 
 from ...mesh.geometry import bounding_box_diagonal, mean_edge_length
+from .catalogue import Case, Wrong, judge, number
 from .result import Mistake, call, exercise
 
-__all__ = ["add_noise", "vertex_rms", "denoising_experiment"]
+__all__ = ["add_noise", "vertex_rms", "denoising_experiment", "denoising_sweep"]
 
 NOISE_SECTION = "section 2 · The noise, yours"
 RMS_SECTION = "section 3 · The error, yours"
@@ -338,8 +339,8 @@ def _near(value, target):
         "lessons.metrics.vertex_rms",
         "lessons.metrics.denoising_metrics",
         "lessons.metrics.MeshComparison",
-        "teaching.sweep.smoothing_sweep",
-        "teaching.sweep.denoising_comparison",
+        "teaching.experiments.sweep.smoothing_sweep",
+        "teaching.experiments.sweep.denoising_comparison",
     ),
     allow=("lessons.smoothing.implicit_smoothing",),
 )
@@ -459,3 +460,191 @@ def denoising_experiment(fn):
         "the seed",
         "a tenth of the size",
     ]
+
+
+# ------------------------------------------------------------------ the sweep over step and count
+SWEEP_SECTION = "section 5 · The sweep, yours"
+# the cases: icospheres of 642 and 162 vertices, scaled and moved away from the origin, with noise of 1.4 mean
+# edges; three steps around the best, six iterations. Their tables, right and wrong, are made once per kernel.
+_SWEEP_TAUS_ELL2, _SWEEP_ITERATIONS = (0.05, 0.2, 0.8), 6
+
+
+def _sweep_table(W, F, truth, taus, iterations, weights="cotan", step="implicit", carry=False, rebuild=False):
+    """E[i, k] for a sweep done right (the defaults) or in one of the catalogue's wrong ways."""
+    from scipy.sparse.linalg import splu
+
+    from ...lessons.laplace import laplacian
+
+    d = bounding_box_diagonal(truth)
+    rms = lambda P: float(np.sqrt(np.mean(np.sum((P - truth) ** 2, axis=1)))) / d  # noqa: E731
+    E, P, (M, C) = np.empty((len(taus), iterations + 1)), W, laplacian(W, F, weights)
+    for i, tau in enumerate(taus):
+        P = P if carry else W
+        E[i, 0] = rms(P)
+        for k in range(1, iterations + 1):
+            if rebuild:
+                M, C = laplacian(P, F, weights)
+            if step == "explicit":
+                P = P + tau * (C @ P) / M.diagonal()[:, None]
+            else:
+                A = M + tau * C if step == "plus" else M - tau * C
+                P = splu(A.tocsc()).solve(P if step == "rhs P" else M @ P)
+            E[i, k] = rms(P)
+    return E
+
+
+#: the wrong tables the catalogue names, by the options of _sweep_table that make them
+_VARIANTS = {
+    "carry": {"carry": True},
+    "rebuild": {"rebuild": True},
+    "explicit": {"step": "explicit"},
+    "plus": {"step": "plus"},
+    "rhs P": {"step": "rhs P"},
+    "uniform": {"weights": "uniform"},
+}
+
+
+def _best(E, taus, count_from=0, pick=np.argmin, index=False):
+    i, k = np.unravel_index(pick(E), E.shape)
+    return (i if index else taus[i]), int(k) + count_from, E
+
+
+@functools.lru_cache(maxsize=1)
+def _sweep_cases():
+    from ..shapes.surfaces import icosphere
+
+    cases = []
+    for label, (V0, F0), scale in (
+        ("an icosphere of 642 vertices", icosphere(3), 40.0),
+        ("one of 162", icosphere(2), 3.0),
+    ):
+        V0, F0 = np.asarray(V0, float) * scale + np.array([-4.0, 9.0, 2.0]), np.asarray(F0)
+        ell = mean_edge_length(V0, F0)
+        W = V0 + 1.4 * ell * np.random.default_rng(17).standard_normal(V0.shape)
+        taus = [t * ell**2 for t in _SWEEP_TAUS_ELL2]
+        tables = {v: _sweep_table(W, F0, V0, taus, _SWEEP_ITERATIONS, **kw) for v, kw in _VARIANTS.items()}
+        tables["noisy"] = _sweep_table(W, F0, W, taus, _SWEEP_ITERATIONS)
+        case = Case(label, W=W, F=F0, V_clean=V0, taus=taus, iterations=_SWEEP_ITERATIONS)
+        cases.append(case.but(right=_best(_sweep_table(W, F0, V0, taus, _SWEEP_ITERATIONS), taus), tables=tables))
+    return cases
+
+
+def _sweep_flat(out, case):
+    """(tau_best, N_best, E) as one float vector, each part on the scale of its right value."""
+    if not isinstance(out, (tuple, list)) or len(out) != 3:
+        raise Mistake(
+            "the function did not return the triple (tau_best, N_best, E)",
+            "end with `return tau_best, N_best, E`",
+            typical=False,
+        )
+    E = np.asarray(out[2], dtype=float) if not isinstance(out[2], (int, float)) else None
+    if E is None or E.ndim != 2:
+        raise Mistake(
+            "E is not a table (a 2-D array)",
+            "E[i, k]: one row per step, one column per count 0..iterations",
+            typical=False,
+        )
+    tau, count = number(out[0], "tau_best"), number(out[1], "N_best")
+    return np.concatenate([[tau / case.taus[-1], count / case.iterations], E.ravel() / case.right[2].max()])
+
+
+def _as(case, tau_N_E):
+    return _sweep_flat(tau_N_E, case)
+
+
+def _wrong(diagnosis, hint, make):
+    return Wrong(diagnosis, hint, build=lambda c: _as(c, make(c)))
+
+
+SWEEP_MISTAKES = [
+    _wrong(
+        "the error is measured against the noisy mesh W (E[:, 0] is 0), not against V_clean",
+        "E = my_vertex_rms(P, V_clean)",
+        lambda c: _best(c.tables["noisy"], c.taus),
+    ),
+    _wrong(
+        "each step's run starts where the previous step's ended, not from the noisy mesh W",
+        "set P = W before each step's iterations",
+        lambda c: _best(c.tables["carry"], c.taus),
+    ),
+    _wrong(
+        "M and C are rebuilt from the smoothed mesh at every iteration: the sweep keeps W's operator",
+        "build M, C = laplacian(W, F) once, before the loops",
+        lambda c: _best(c.tables["rebuild"], c.taus),
+    ),
+    _wrong(
+        "these are explicit steps, P + tau M^-1 C P, not implicit ones",
+        "solve (M - tau C) P' = M P at every iteration",
+        lambda c: _best(c.tables["explicit"], c.taus),
+    ),
+    _wrong(
+        "the sign of tau C is flipped: (M + tau C) P' = M P",
+        "the implicit step solves (M - tau C) P' = M P",
+        lambda c: _best(c.tables["plus"], c.taus),
+    ),
+    _wrong(
+        "the right-hand side is P, not M P",
+        "solve (M - tau C) P' = M P: the areas multiply P too",
+        lambda c: _best(c.tables["rhs P"], c.taus),
+    ),
+    _wrong(
+        "uniform weights: the sweep smooths with the cotangent Laplacian",
+        "M, C = geomlib.laplacian(W, F), whose weights are cotangent",
+        lambda c: _best(c.tables["uniform"], c.taus),
+    ),
+    _wrong(
+        "the table has no column for 0 iterations: E[i, k] is the error after k + 1 steps",
+        "E has iterations + 1 columns, k = 0 being W itself",
+        lambda c: (c.right[0], c.right[1] - 1, c.right[2][:, 1:]),
+    ),
+    _wrong(
+        "the table is transposed: its rows are counts and its columns steps",
+        "E[i, k]: row i for taus[i], column k for k steps",
+        lambda c: (c.right[0], c.right[1], c.right[2].T),
+    ),
+    _wrong(
+        "the best setting is the largest error (argmax), not the smallest",
+        "np.argmin over the whole table",
+        lambda c: _best(c.right[2], c.taus, pick=np.argmax),
+    ),
+    _wrong(
+        "N_best is one too many: the count of column k is k, not k + 1",
+        "the column index k is the number of steps",
+        lambda c: _best(c.right[2], c.taus, count_from=1),
+    ),
+    _wrong(
+        "tau_best is the index of the best step, not the step itself",
+        "return taus[i], not i",
+        lambda c: _best(c.right[2], c.taus, index=True),
+    ),
+    Wrong(
+        "the table or the best setting differs from the right one on {label}",
+        "E[i, k] = my_vertex_rms after k implicit steps of taus[i]",
+        typical=False,
+    ),
+]
+
+
+@exercise(
+    "denoising_sweep",
+    reread=SWEEP_SECTION,
+    forbid=(
+        "lessons.noise.denoising_sweep",
+        "lessons.smoothing.implicit_smoothing",
+        "lessons.smoothing.ImplicitSmoother",
+        "lessons.noise.denoising_experiment",
+        "lessons.metrics.vertex_rms",
+        "lessons.metrics.MeshComparison",
+        "teaching.experiments.sweep.smoothing_sweep",
+        "teaching.experiments.sweep.denoising_comparison",
+    ),
+    allow=("lessons.laplace.laplacian",),
+)
+def denoising_sweep(fn):
+    """Check ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` (section 5 of notebook 07)."""
+    cases = _sweep_cases()
+    answers = [
+        _sweep_flat(call(fn, *(x.copy() if hasattr(x, "copy") else x for x in c.inputs.values())), c) for c in cases
+    ]
+    judge(SWEEP_MISTAKES, cases, answers, right=lambda c: _as(c, c.right))
+    return [c.label + f" ({len(c.taus)} steps, {c.iterations} iterations)" for c in cases]

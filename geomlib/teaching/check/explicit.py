@@ -10,7 +10,8 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from ...lessons.laplace import laplacian
-from .. import surfaces
+from ..shapes import surfaces
+from .catalogue import positions
 from .result import Mistake, call, close, exercise
 
 __all__ = ["explicit_step", "explicit_step_limit", "smoothing_loop"]
@@ -39,25 +40,6 @@ def step_cases():
 _STEP_NAN_HINT = "divide row i of C P by M_ii (M.diagonal(), positive on these meshes), not by a dense 1 / M"
 
 
-def positions(out, n, what="the function", nan_hint=_STEP_NAN_HINT):
-    """Check that ``out`` is an (n, 3) array of positions; return it as float. ``nan_hint`` is the
-    hint for NaN or infinite positions, which each exercise can cause in its own way."""
-    P = np.asarray(out.toarray() if hasattr(out, "toarray") else out)
-    if P.shape != (n, 3):
-        raise Mistake(
-            f"{what} returned shape {P.shape}, expected ({n}, 3): one new position per vertex",
-            "return the (n, 3) array of new positions, like P",
-            typical=False,
-        )
-    if not np.isfinite(P.astype(float)).all():
-        raise Mistake(
-            f"{what} returned NaN or infinite positions",
-            nan_hint,
-            typical=False,
-        )
-    return P.astype(float)
-
-
 @exercise(
     "explicit_step",
     reread=_REREAD_STEP,
@@ -76,7 +58,7 @@ def explicit_step(fn):
         m = M.diagonal()[:, None]
         tau = 0.3 / np.abs(C.diagonal() / M.diagonal()).max()
         for P in (V, V + 0.05 * rng.standard_normal(V.shape)):
-            out = positions(call(fn, P.copy(), M.copy(), C.copy(), tau), len(V))
+            out = positions(call(fn, P.copy(), M.copy(), C.copy(), tau), len(V), nan_hint=_STEP_NAN_HINT)
             move = tau * (C @ P) / m
             if close(out, P + move):
                 continue
@@ -153,6 +135,7 @@ def _lam(A, M):
         "lessons.smoothing.highest_frequency_mode",
         "numerics.eigen.largest_eigenvalue",
     ),
+    allow=("lessons.laplace.laplacian",),
 )
 def explicit_step_limit(fn):
     """Check ``fn(V, F) -> tau_max`` = 2 / lam_max, lam_max the largest eigenvalue of -M^-1 C
@@ -260,6 +243,7 @@ def _boundary_mask(F, n):
         "lessons.operator.laplace_operator",
     ),
     own=("lessons.smoothing.explicit_smoothing", "lessons.smoothing.ExplicitSmoother"),
+    allow=("lessons.laplace.laplacian", "mesh.topology.boundary_vertices"),
 )
 def smoothing_loop(fn):
     """Check ``fn(V, F, tau, iterations) -> P``: ``iterations`` explicit steps P <- P + tau M^-1 C P

@@ -1,50 +1,46 @@
-"""Checks of the exercises of notebook 02: the ellipsoid's fundamental forms and its normal curvature.
+"""Checks of the exercises of notebook 02: the ellipsoid's fundamental forms, and the normal curvature
+computed from whatever fundamental forms it is handed.
 
-The learner's expressions are compared by value, at a few points of the
-parameter domain and a few semi-axes, so an unsimplified but correct
-expression passes: simplification is a matter of taste, not a mistake.
+``fundamental_forms``: the learner's expressions are compared by value at points drawn anew each run on
+ellipsoids with three different semi-axes (``F != 0`` there), so an unsimplified but correct expression
+passes: simplification is a matter of taste, not a mistake. The reference values come from p's derivatives
+written out with numpy here, independent of sympy.
 
-sympy is imported inside the checks that use it: it takes about a second to
-import, and every notebook imports ``geomlib.check``, most of them without a
-symbolic exercise.
+``normal_curvature``: the learner's function receives a forms function and evaluates it itself. The check
+hands it the forms of two surfaces written here: the ellipsoid, at a generic point and at (a, 0, 0), and a
+Monge patch whose ``F`` and ``f`` are both non-zero, so that a function which ignores the forms (the
+ellipsoid's kappa_n at (a, 0, 0) written in) or which drops a mixed term is told apart.
+
+sympy is imported inside the checks: it takes about a second to import, and every notebook imports
+``geomlib.check``, most of them without a symbolic exercise.
 """
+
+import functools
 
 import numpy as np
 
-from .result import Mistake, call, exercise
+from .catalogue import Case, Wrong, judge, number
+from .result import Mistake, call, case_rng, exercise
 
 __all__ = ["fundamental_forms", "normal_curvature"]
 
-# (a, b, c, u, v): generic points (F != 0 at each, 0 < v < pi) on three different ellipsoids
-_POINTS = np.array([[1.0, 0.7, 0.5, 0.3, 1.1], [2.0, 1.3, 0.6, 2.1, 0.4], [0.8, 1.5, 1.1, 4.0, 2.5]])
 _NAMES = ("E", "F", "G", "e", "f", "g")
+_PAIR = "return the pair (I, II): I = Matrix([[E, F], [F, G]]), II = Matrix([[e, f], [f, g]])"
 
 
-def _expressions(out):
-    """The six expressions (E, F, G, e, f, g) from a 6-tuple or from the pair of 2x2 matrices (I, II)."""
+# ------------------------------------------------------------------------------------ fundamental_forms
+def _coefficients(out):
+    """The six expressions (E, F, G, e, f, g) from the pair of 2x2 matrices (I, II), or from six expressions."""
     import sympy as sp
 
     if isinstance(out, (tuple, list)) and len(out) == 6:
         return [sp.sympify(x) for x in out]
     if isinstance(out, (tuple, list)) and len(out) == 2:
-        I, II = (sp.Matrix(x) if not isinstance(x, sp.MatrixBase) else x for x in out)
+        I, II = (x if isinstance(x, sp.MatrixBase) else sp.Matrix(x) for x in out)
         if I.shape != (2, 2) or II.shape != (2, 2):
-            raise Mistake(
-                f"the forms have shapes {I.shape} and {II.shape}, expected two 2 x 2 matrices",
-                "return (I, II) with I = Matrix([[E, F], [F, G]]) and II = Matrix([[e, f], [f, g]])",
-                typical=False,
-            )
-        for name, A in (("I", I), ("II", II)):
-            if sp.simplify(A[0, 1] - A[1, 0]) != 0:
-                raise Mistake(
-                    f"{name} is not symmetric", f"both off-diagonal entries of {name} are the same dot product"
-                )
+            raise Mistake(f"the forms have shapes {I.shape} and {II.shape}, not 2 x 2", _PAIR, typical=False)
         return [I[0, 0], I[0, 1], I[1, 1], II[0, 0], II[0, 1], II[1, 1]]
-    raise Mistake(
-        f"the function returned {type(out).__name__}, not (E, F, G, e, f, g) or (I, II)",
-        "end with `return E, F, G, e, f, g` (sympy expressions in a, b, c, u, v)",
-        typical=False,
-    )
+    raise Mistake(f"the function returned {type(out).__name__}, not the pair (I, II)", _PAIR, typical=False)
 
 
 def _values(exprs, symbols, points):
@@ -59,7 +55,7 @@ def _values(exprs, symbols, points):
         )
     f = sp.lambdify(symbols, exprs, modules="numpy")
     with np.errstate(all="ignore"):
-        vals = np.array([np.asarray(f(*pt), dtype=complex) for pt in points]).T
+        vals = np.array([np.broadcast_to(np.asarray(f(*pt), dtype=complex), 6) for pt in points]).T
     if not np.all(np.isfinite(vals)) or np.abs(vals.imag).max() > 1e-9 * (1 + np.abs(vals.real).max()):
         raise Mistake(
             "the expressions are not real numbers at points inside the domain",
@@ -69,183 +65,321 @@ def _values(exprs, symbols, points):
     return vals.real
 
 
-def _reference(points):
-    """(E, F, G, e, f, g) at the points, from p's derivatives written out (independent of sympy), and |p_u x p_v|."""
+def _derivatives(points):
+    """p_u, p_v, p_uu, p_uv, p_vv (each (k, 3)) of the ellipsoid at the points (a, b, c, u, v), written out."""
     a, b, c, u, v = points.T
-    cu, su, cv, sv = np.cos(u), np.sin(u), np.cos(v), np.sin(v)
-    p_u = np.stack([-a * su * sv, b * cu * sv, 0 * u], axis=1)
-    p_v = np.stack([a * cu * cv, b * su * cv, -c * sv], axis=1)
-    p_uu = np.stack([-a * cu * sv, -b * su * sv, 0 * u], axis=1)
-    p_uv = np.stack([-a * su * cv, b * cu * cv, 0 * u], axis=1)
-    p_vv = np.stack([-a * cu * sv, -b * su * sv, -c * cv], axis=1)
+    cu, su, cv, sv, zero = np.cos(u), np.sin(u), np.cos(v), np.sin(v), 0 * u
+    return (
+        np.stack([-a * su * sv, b * cu * sv, zero], axis=1),
+        np.stack([a * cu * cv, b * su * cv, -c * sv], axis=1),
+        np.stack([-a * cu * sv, -b * su * sv, zero], axis=1),
+        np.stack([-a * su * cv, b * cu * cv, zero], axis=1),
+        np.stack([-a * cu * sv, -b * su * sv, -c * cv], axis=1),
+    )
+
+
+def _reference(points):
+    """(6, k) E, F, G, e, f, g at the points, and |p_u x p_v| (k,): the workbook's II takes -n = p_u x p_v / |.|."""
+    p_u, p_v, p_uu, p_uv, p_vv = _derivatives(points)
     m = np.cross(p_u, p_v)
     cross = np.linalg.norm(m, axis=1)
-    minus_n = m / cross[:, None]  # the inward normal -n on this parameterisation: the workbook's II
-    dot = lambda x, y: np.einsum("ij,ij->i", x, y)
-    ref = np.array(
-        [dot(p_u, p_u), dot(p_u, p_v), dot(p_v, p_v), dot(p_uu, minus_n), dot(p_uv, minus_n), dot(p_vv, minus_n)]
-    )
-    return ref, cross
+    minus_n = m / cross[:, None]
+    dot = lambda x, y: np.einsum("ij,ij->i", x, y)  # noqa: E731
+    first = [dot(p_u, p_u), dot(p_u, p_v), dot(p_v, p_v)]
+    return np.array(first + [dot(p_uu, minus_n), dot(p_uv, minus_n), dot(p_vv, minus_n)]), cross
 
 
-def _same(x, y):
-    return np.allclose(x, y, rtol=1e-7, atol=1e-9)
+def _forms_case(label, points):
+    right, cross = _reference(points)
+    swapped, _ = _reference(points[:, [0, 1, 2, 4, 3]])  # the true forms at (v, u)
+    return Case(label, points=points).but(right=right, cross=cross, at_swapped=swapped)
+
+
+_FIRST, _SECOND = [0, 1, 2], [3, 4, 5]
+
+
+def _with(c, first=None, second=None):
+    out = c.right.copy()
+    if first is not None:
+        out[_FIRST] = first
+    if second is not None:
+        out[_SECOND] = second
+    return out
+
+
+def _same_factor(got, right):
+    """Whether ``got`` is ``right`` times one factor other than 1 (where ``right`` is clearly non-zero)."""
+    usable = np.abs(right) > 1e-9 * np.abs(right).max()
+    ratio = got[usable] / right[usable]
+    return bool(usable.any() and np.allclose(ratio, ratio[0], rtol=1e-7) and not np.isclose(ratio[0], 1.0))
+
+
+FORMS_MISTAKES = [
+    Wrong(
+        "u and v are swapped: u is taken as the polar angle and v as the longitude",
+        "p(u, v) = (a cos u sin v, b sin u sin v, c cos v): u turns around the z axis, v runs from the north "
+        "pole (v = 0) to the south pole (v = pi)",
+        # the learner's p(u, v) is the true p(v, u): its p_u is the true p_v, and p_u x p_v turns round
+        build=lambda c: c.at_swapped[[2, 1, 0, 5, 4, 3]] * np.array([[1], [1], [1], [-1], [-1], [-1]]),
+    ),
+    Wrong(
+        "u and v are exchanged: the forms come out at the point (v, u) (the parameters taken in the wrong order)",
+        "the function receives a, b, c, u, v in this order; p(u, v) = (a cos u sin v, b sin u sin v, c cos v)",
+        build=lambda c: c.at_swapped,
+    ),
+    Wrong(
+        "E and G are exchanged (and e and g): the derivatives in u and v are swapped",
+        "E = p_u . p_u and e = -p_uu . n, with p_u = dp/du; u is the longitude, v the polar angle",
+        build=lambda c: c.right[[2, 1, 0, 5, 4, 3]],
+    ),
+    Wrong(
+        "E and G are exchanged",
+        "E = p_u . p_u with p_u = dp/du, G = p_v . p_v",
+        build=lambda c: _with(c, first=c.right[[2, 1, 0]]),
+    ),
+    Wrong(
+        "F has the wrong sign",
+        "F = p_u . p_v, the dot product of the two tangents as they are",
+        build=lambda c: _with(c, first=c.right[_FIRST] * np.array([[1], [-1], [1]])),
+    ),
+    Wrong(
+        "E and G are the lengths |p_u|, |p_v|, not their squares",
+        "E = p_u . p_u = |p_u|^2, G = p_v . p_v = |p_v|^2",
+        build=lambda c: _with(c, first=[np.sqrt(c.right[0]), c.right[1], np.sqrt(c.right[2])]),
+    ),
+    Wrong(
+        "the sign of the normal is flipped: e, f, g are all negated",
+        "the workbook's II uses the inward normal -n = p_u x p_v / |p_u x p_v| on this ellipsoid, so that every "
+        "curvature of a convex surface is positive",
+        build=lambda c: _with(c, second=-c.right[_SECOND]),
+    ),
+    Wrong(
+        "the normal is not normalised: e, f, g are multiplied by |p_u x p_v|",
+        "divide p_u x p_v by its length before dotting it with p_uu, p_uv, p_vv",
+        build=lambda c: _with(c, second=c.right[_SECOND] * c.cross),
+    ),
+    Wrong(
+        "the normal is not normalised and its sign is flipped: e, f, g are multiplied by -|p_u x p_v|",
+        "-n = p_u x p_v / |p_u x p_v|: a unit vector, pointing inwards on this ellipsoid",
+        build=lambda c: _with(c, second=-c.right[_SECOND] * c.cross),
+    ),
+    Wrong(
+        "the normal is divided by |p_u x p_v| twice: e, f, g are divided by |p_u x p_v|",
+        "-n = p_u x p_v / |p_u x p_v|, divided once",
+        build=lambda c: _with(c, second=c.right[_SECOND] / c.cross),
+    ),
+    Wrong(
+        "e, f, g are all off by the same factor: the normal is not a unit vector",
+        "-n = p_u x p_v / |p_u x p_v|, a unit vector",
+        when=lambda answer, right, c: _same_factor(answer[_SECOND], right[_SECOND]),
+    ),
+    Wrong(
+        "e and g are exchanged: the second derivatives in u and v are swapped",
+        "e = -p_uu . n, f = -p_uv . n, g = -p_vv . n",
+        build=lambda c: _with(c, second=c.right[[5, 4, 3]]),
+    ),
+    Wrong(
+        "F is left out (taken as 0): p_u and p_v are perpendicular only on the coordinate planes",
+        "F = p_u . p_v, which is not 0 at a generic point of an ellipsoid with a != b",
+        build=lambda c: _with(c, first=[c.right[0], 0 * c.right[1], c.right[2]]),
+    ),
+]
+
+
+def forms_cases(rng):
+    """Three ellipsoids with different semi-axes (a != b, so F != 0), two points each, drawn with ``rng``."""
+    cases = []
+    for k in range(3):
+        axes = np.sort(rng.uniform(0.4, 2.5, size=3))[rng.permutation(3)]
+        while np.min(np.abs(np.diff(np.sort(axes)))) < 0.15:  # three clearly different semi-axes
+            axes = np.sort(rng.uniform(0.4, 2.5, size=3))[rng.permutation(3)]
+        u = rng.uniform(0.2, 1.3, size=2) + rng.integers(0, 4, size=2) * np.pi / 2  # away from sin 2u = 0
+        v = rng.uniform(0.25, 1.3, size=2) + rng.integers(0, 2, size=2) * (np.pi / 2 - 0.1)
+        points = np.column_stack([np.tile(axes, (2, 1)), u, v])
+        cases.append(_forms_case(f"the ellipsoid with semi-axes {', '.join(f'{x:.2f}' for x in axes)}", points))
+    return cases
 
 
 @exercise(
     "fundamental_forms",
     reread="The definitions and Steps 1-2 · the tangents p_u, p_v and the inward normal p_u x p_v / |p_u x p_v| = -n",
     forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
+    tools=("sympy", "numpy", "scipy"),
 )
 def fundamental_forms(fn):
-    """Check ``fn(a, b, c, u, v) -> (E, F, G, e, f, g)`` (or ``(I, II)``) for the ellipsoid, by value."""
+    """Check ``fn(a, b, c, u, v) -> (I, II)`` (or the six E, F, G, e, f, g) for the ellipsoid, by value."""
     import sympy as sp
 
-    a, b, c = sp.symbols("a b c", positive=True)
-    u, v = sp.symbols("u v", real=True)
-    exprs = _expressions(call(fn, a, b, c, u, v))
-    vals = _values(exprs, (a, b, c, u, v), _POINTS)
-    ref, cross = _reference(_POINTS)
-    first, second = vals[:3], vals[3:]
-    swap = [2, 1, 0]
-    # u as the polar angle and v as the longitude: the learner's E(u, v) is the true G(v, u)
-    at_swapped = _values(exprs, (a, b, c, u, v), _POINTS[:, [0, 1, 2, 4, 3]])
-    if not _same(first, ref[:3]) and (_same(at_swapped[:3], ref[:3]) or _same(at_swapped[[2, 1, 0]], ref[:3])):
-        raise Mistake(
-            "u and v are swapped: u is taken as the polar angle and v as the longitude",
-            "p(u, v) = (a cos u sin v, b sin u sin v, c cos v): u turns around the z axis, "
-            "v runs from the north pole (v = 0) to the south pole (v = pi)",
-        )
-    if not _same(first, ref[:3]):
-        if _same(first, ref[:3][swap]):
-            raise Mistake(
-                "u and v are swapped: E and G are exchanged",
-                "E = p_u . p_u with p_u = dp/du; u is the longitude, v the polar angle",
-            )
-        if _same(first[[0, 2]], ref[[0, 2]]) and _same(first[1], -ref[1]):
-            raise Mistake("F has the wrong sign", "F = p_u . p_v, the dot product of the two tangents as they are")
-        wrong = [n for n, x, y in zip(_NAMES, first, ref[:3]) if not _same(x, y)]
-        raise Mistake(
-            f"{', '.join(wrong)} of the first fundamental form differ from p_u . p_u, p_u . p_v, p_v . p_v",
-            "differentiate p(u, v) = (a cos u sin v, b sin u sin v, c cos v) once in u and once in v",
-            typical=False,
-        )
-    if _same(second, ref[3:]):
-        return ["E, F, G, e, f, g at three generic points (F != 0) of three ellipsoids"]
-    if _same(second, ref[3:][swap]):
-        raise Mistake(
-            "u and v are swapped in the second fundamental form: e and g are exchanged", "e = -p_uu . n, g = -p_vv . n"
-        )
-    if _same(second, -ref[3:]):
-        raise Mistake(
-            "the sign of the normal is flipped: e, f, g are all negated",
-            "the workbook's II uses the inward normal -n = p_u x p_v / |p_u x p_v| on this ellipsoid, "
-            "so that every curvature of a convex surface is positive",
-        )
-    for sign in (1, -1):
-        if _same(second, sign * cross * ref[3:]):
-            raise Mistake(
-                "the normal is not normalised: e, f, g are multiplied by |p_u x p_v| = sin v W",
-                "divide p_u x p_v by its length before dotting it with p_uu, p_uv, p_vv",
-            )
-    with np.errstate(all="ignore"):
-        ratio = second / ref[3:]
-    usable = np.isfinite(ratio) & (np.abs(ref[3:]) > 1e-9)
-    if usable.any() and np.allclose(ratio[usable], ratio[usable][0]) and not np.isclose(abs(ratio[usable][0]), 1):
-        raise Mistake(
-            f"e, f, g are all off by the same factor {ratio[usable][0]:.4g}: the normal is not a unit vector",
-            "-n = p_u x p_v / |p_u x p_v|, a unit vector",
-        )
-    wrong = [n for n, x, y in zip(_NAMES[3:], second, ref[3:]) if not _same(x, y)]
-    raise Mistake(
-        f"{', '.join(wrong)} of the second fundamental form differ from -p_uu . n, -p_uv . n, -p_vv . n",
-        "take the second derivatives of p and dot them with the unit normal -n = p_u x p_v / |p_u x p_v|",
-        typical=False,
+    symbols = sp.symbols("a b c", positive=True) + sp.symbols("u v", real=True)
+    exprs = _coefficients(call(fn, *symbols))
+    cases = forms_cases(case_rng())
+    answers = [_values(exprs, symbols, c.points) for c in cases]
+    judge(FORMS_MISTAKES, cases, answers, right=lambda c: c.right)
+    return ["E, F, G, e, f, g at two generic points (F != 0) of three ellipsoids"]
+
+
+# ------------------------------------------------------------------------------------ normal_curvature
+@functools.lru_cache(maxsize=None)
+def _surface(kind):
+    """(symbols, I, II) of a surface of the check, in its own symbols a, b, c, u, v (II against p_u x p_v / |.|)."""
+    import sympy as sp
+
+    a, b, c, u, v = sp.symbols("a b c u v", real=True)
+    if kind == "ellipsoid":
+        p = sp.Matrix([a * sp.cos(u) * sp.sin(v), b * sp.sin(u) * sp.sin(v), c * sp.cos(v)])
+    else:  # a Monge patch z = h(u, v) with h_u h_v != 0 (so F != 0) and h_uv != 0 (so f != 0)
+        p = sp.Matrix([u, v, c * sp.sin(u / a) * sp.cos(v / b) + u * v / (a + b)])
+    p_u, p_v = p.diff(u), p.diff(v)
+    m = p_u.cross(p_v)
+    unit = m / sp.sqrt(m.dot(m))
+    I = sp.Matrix([[p_u.dot(p_u), p_u.dot(p_v)], [p_u.dot(p_v), p_v.dot(p_v)]])
+    second = [p.diff(u, u).dot(unit), p.diff(u, v).dot(unit), p.diff(v, v).dot(unit)]
+    II = sp.Matrix([[second[0], second[1]], [second[1], second[2]]])
+    return (a, b, c, u, v), I, II
+
+
+def _forms_of(kind):
+    """The forms function the learner's routine is handed: (I, II) in the symbols (or numbers) it is given."""
+
+    def forms(a, b, c, u, v):
+        own, I, II = _surface(kind)
+        at = dict(zip(own, (a, b, c, u, v)))
+        return I.subs(at, simultaneous=True), II.subs(at, simultaneous=True)
+
+    forms.__name__ = f"{kind}_forms"
+    return forms
+
+
+def _numbers(kind, a, b, c, u, v):
+    """E, F, G, e, f, g of the surface at the numbers (floats)."""
+    own, I, II = _surface(kind)
+    at = dict(zip(own, (a, b, c, u, v)))
+    return [float(x.evalf(subs=at)) for x in (I[0, 0], I[0, 1], I[1, 1], II[0, 0], II[0, 1], II[1, 1])]
+
+
+def _kappa(E, F, G, e, f, g, du, dv, two=2.0, divide=True):
+    II_tt = e * du**2 + two * f * du * dv + g * dv**2
+    I_tt = E * du**2 + two * F * du * dv + G * dv**2
+    return II_tt / I_tt if divide else II_tt
+
+
+def _tangent(E, F, G, phi):
+    root_E, area = np.sqrt(E), np.sqrt(E * G - F**2)
+    return np.cos(phi) / root_E - np.sin(phi) * F / (root_E * area), np.sin(phi) * root_E / area
+
+
+def _right(E, F, G, e, f, g, phi):
+    with np.errstate(all="ignore"):  # the forms evaluated at (v, u) may sit at a pole (E = 0)
+        return _kappa(E, F, G, e, f, g, *_tangent(E, F, G, phi))
+
+
+def _kappa_case(label, kind, a, b, c, u, v, phis):
+    coeffs = _numbers(kind, a, b, c, u, v)
+    return Case(label, a=a, b=b, c=c, u=u, v=v).but(
+        kind=kind, phis=phis, coeffs=coeffs, swapped=_numbers(kind, a, b, c, v, u)
     )
 
 
-# (a, b, c) triples with b != c (at b = c every direction at (a, 0, 0) is principal) and angles phi
-_AXES = np.array([[1.0, 0.7, 0.5], [2.0, 1.5, 0.8], [1.3, 0.6, 1.9]])
-_PHIS = np.array([0.0, 0.4, 1.1, np.pi / 2, 2.5, 4.0])
+def _on(c, rule):
+    """The wrong answer ``rule(E, F, G, e, f, g, phi)`` at every angle of case c."""
+    return np.array([rule(*c.coeffs, phi) for phi in c.phis])
+
+
+KAPPA_MISTAKES = [
+    Wrong(
+        "the function does not use the forms it receives: it gives the ellipsoid's kappa_n at (a, 0, 0) everywhere",
+        "call forms(a, b, c, u, v) with sympy symbols, substitute the numbers, and build kappa_n from its I and II",
+        build=lambda c: c.a * np.cos(c.phis) ** 2 / c.b**2 + c.a * np.sin(c.phis) ** 2 / c.c**2,
+    ),
+    Wrong(
+        "the sign is flipped",
+        "kappa_n = II(t, t) / I(t, t) with II as the forms give it, no minus sign",
+        build=lambda c: -_on(c, _right),
+    ),
+    Wrong(
+        "F is ignored in the tangent: (du, dv) = (cos phi / sqrt(E), sin phi / sqrt(G)) treats p_u and p_v as "
+        "perpendicular",
+        "where F != 0, p_v is not perpendicular to p_u: w, the unit tangent perpendicular to p_u, is a combination "
+        "of p_u and p_v with w . p_u = 0",
+        build=lambda c: _on(
+            c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, np.cos(p) / np.sqrt(E), np.sin(p) / np.sqrt(G))
+        ),
+    ),
+    Wrong(
+        "phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi)",
+        "phi is an angle on the surface, from p_u: t = cos phi p_u / |p_u| + sin phi w, with |p_u| = sqrt(E)",
+        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, np.cos(p), np.sin(p))),
+    ),
+    Wrong(
+        "II(t, t) is not divided by I(t, t), and t = (cos phi, sin phi) in (du, dv) is not a unit vector",
+        "kappa_n = II(t, t) / I(t, t); with the unit tangent t(phi), I(t, t) = 1",
+        build=lambda c: _on(
+            c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, np.cos(p), np.sin(p), divide=False)
+        ),
+    ),
+    Wrong(
+        "the angle turns the other way: w points away from p_v (kappa_n(phi) came out kappa_n(-phi))",
+        "w is the unit tangent perpendicular to p_u on the side of p_v: w . p_v > 0",
+        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _right(E, F, G, e, f, g, -p)),
+    ),
+    Wrong(
+        "phi is measured from p_v instead of p_u (the roles of u and v exchanged)",
+        "phi = 0 is the direction of p_u: t(0) = p_u / sqrt(E)",
+        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _right(G, F, E, g, f, e, p)),
+    ),
+    Wrong(
+        "the mixed terms lack their factor 2: I(t, t) = E du^2 + 2 F du dv + G dv^2, and II(t, t) likewise",
+        "t^T I t = E du^2 + 2 F du dv + G dv^2: F stands twice in the matrix I",
+        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, *_tangent(E, F, G, p), two=1.0)),
+    ),
+    Wrong(
+        "phi is converted from degrees, but it is already in radians",
+        "phi is in radians: use np.cos(phi), np.sin(phi) as they are",
+        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _right(E, F, G, e, f, g, np.radians(p))),
+    ),
+    Wrong(
+        "the forms are evaluated at (v, u) instead of (u, v)",
+        "substitute u for the symbol u and v for the symbol v",
+        build=lambda c: np.array([_right(*c.swapped, phi) for phi in c.phis]),
+    ),
+]
+
+
+def kappa_cases(rng):
+    phis = np.concatenate([[0.0, np.pi / 2], rng.uniform(0.2, 1.3, size=2), rng.uniform(1.8, 3.0, size=1)])
+    a, b, c = rng.uniform(0.6, 1.0), rng.uniform(1.1, 1.5), rng.uniform(1.6, 2.2)
+    u, v = rng.uniform(0.3, 1.2), rng.uniform(0.4, 1.2)
+    return [
+        _kappa_case("the ellipsoid at (a, 0, 0)", "ellipsoid", a, b, c, 0.0, np.pi / 2, phis),
+        _kappa_case(f"the ellipsoid at (u, v) = ({u:.2f}, {v:.2f}), where F != 0", "ellipsoid", a, b, c, u, v, phis),
+        _kappa_case(
+            f"a Monge patch at (u, v) = ({v:.2f}, {u:.2f}), where F and f != 0", "monge", c, b, 0.7, v, u, phis
+        ),
+    ]
 
 
 @exercise(
     "normal_curvature",
-    reread="Step 4 · The point (a, 0, 0) and its normal sections",
+    reread="Step 5 · the unit tangent t(phi) = cos phi p_u / |p_u| + sin phi w and kappa_n = II(t, t) / I(t, t)",
     forbid=(
+        "lessons.symbolic.forms_normal_curvature",
+        "lessons.symbolic.unit_tangent",
         "lessons.symbolic.ellipsoid_normal_curvature",
         "lessons.symbolic.ParametricSurface",
         "lessons.symbolic.ellipsoid",
     ),
+    own=("lessons.symbolic.forms_normal_curvature", "lessons.symbolic.unit_tangent"),
+    tools=("numpy", "scipy", "sympy"),
 )
 def normal_curvature(fn):
-    """Check ``fn(a, b, c, phi) -> kappa_n`` at (a, 0, 0), phi in radians from p_u (numbers or sympy numbers)."""
-    got = np.empty((len(_AXES), len(_PHIS)))
-    for i, (a, b, c) in enumerate(_AXES):
-        for j, phi in enumerate(_PHIS):
-            out = call(fn, float(a), float(b), float(c), float(phi))
-            try:
-                got[i, j] = float(out)
-            except (TypeError, ValueError):
-                raise Mistake(
-                    f"the function returned {type(out).__name__} ({out!s:.60}), not a number",
-                    "return kappa_n as one number for the given a, b, c, phi (substitute them "
-                    "into a sympy expression, or write it with numpy)",
-                    typical=False,
-                ) from None
-    a, b, c = (_AXES[:, k, None] for k in range(3))
-    cos2, sin2 = np.cos(_PHIS) ** 2, np.sin(_PHIS) ** 2
-    right = a * cos2 / b**2 + a * sin2 / c**2
-    if _same(got, right):
-        return ["(a, 0, 0) of three ellipsoids, six directions each"]
-    diagnoses = [
-        (
-            -right,
-            "the sign is flipped",
-            "at (a, 0, 0) the ellipsoid bends away from its outward normal: kappa_n > 0, as on a sphere",
-        ),
-        (
-            a * sin2 / b**2 + a * cos2 / c**2,
-            "kappa_n(0) came out a / c^2: b and c are exchanged, or phi is measured from p_v instead of p_u",
-            "phi = 0 is the direction of p_u = (0, b, 0), of length b, so kappa_n(0) = e / E = a / b^2",
-        ),
-        (
-            np.broadcast_to(a, right.shape),
-            "kappa_n = a for every phi: II(t, t) is not divided by the first form",
-            "kappa_n = II(t, t) / I(t, t); the unit tangent at angle phi from p_u has (du, dv) = "
-            "(cos phi / b, sin phi / c), since |p_u| = b and |p_v| = c, and then I(t, t) = 1",
-        ),
-        (
-            np.broadcast_to(a / b**2, right.shape),
-            "kappa_n = a / b^2 for every phi: only E divides, for both directions",
-            "divide II(t, t) by I(t, t), which mixes E and G as the direction turns",
-        ),
-        (
-            a / (b**2 * cos2 + c**2 * sin2),
-            "phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi) treats p_u, p_v as unit vectors",
-            "the unit tangent at angle phi has (du, dv) = (cos phi / b, sin phi / c), since |p_u| = b and |p_v| = c",
-        ),
-        (
-            a * cos2 / b + a * sin2 / c,
-            "kappa_n(0) came out a / b: II is divided by the length |p_u| = b, not by I(p_u, p_u) = b^2",
-            "with (du, dv) = (cos phi / b, sin phi / c), II(t, t) = a cos^2 phi / b^2 + a sin^2 phi / c^2",
-        ),
-        (
-            a * cos2 / b**4 + a * sin2 / c**4,
-            "the first form divides twice",
-            "with (du, dv) = (cos phi / b, sin phi / c) the tangent is already a unit vector: I(t, t) = 1",
-        ),
-    ]
-    for wrong, diagnosis, hint in diagnoses:
-        if _same(got, wrong):
-            raise Mistake(diagnosis, hint)
-    if np.allclose(got[:, 0], right[:, 0]) and np.allclose(got[:, 3], right[:, 3]):
-        raise Mistake(
-            "kappa_n is right along p_u and p_v but not between them",
-            "Euler: kappa_n = kappa_u cos^2 phi + kappa_v sin^2 phi, squares of cos and sin",
+    """Check ``fn(forms, a, b, c, u, v, phi) -> kappa_n``: forms(a, b, c, u, v) -> (I, II) in sympy; numbers in."""
+    cases = kappa_cases(case_rng())
+    hint = "return kappa_n as one number for the given forms, a, b, c, u, v and phi"
+    answers = [
+        np.array(
+            [number(call(fn, _forms_of(c.kind), c.a, c.b, c.c, c.u, c.v, float(phi)), hint=hint) for phi in c.phis]
         )
-    raise Mistake(
-        "kappa_n differs from II(t, t) / I(t, t) at (a, 0, 0)",
-        "at (a, 0, 0): I = diag(b^2, c^2), II = diag(a, a), (du, dv) = (cos phi / b, sin phi / c)",
-        typical=False,
-    )
+        for c in cases
+    ]
+    judge(KAPPA_MISTAKES, cases, answers, right=lambda c: _on(c, _right))
+    return [c.label for c in cases]

@@ -9,7 +9,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from ...lessons.laplace import laplacian
-from .explicit import positions, step_cases
+from .catalogue import positions
+from .explicit import step_cases
 from .result import Mistake, call, close, exercise
 
 __all__ = ["implicit_step"]

@@ -5,15 +5,15 @@ triangle, a tetrahedron, a regular grid, a sphere, the ellipsoid) and stops at
 the first thing that is wrong, named as the typical mistake it is ("the sign
 is flipped") with a one-line hint and the derivation to reread.
 
-Writing a check::
+Writing a check: the catalogue of typical mistakes is data, read by one matcher
+(``check.catalogue``: its docstring is the guide, with a complete example)::
 
-    @exercise("uniform_laplacian", reread="section 2 · The uniform Laplacian, derived")
+    @exercise("uniform_laplacian", reread="section 2 · The uniform Laplacian, derived", forbid=(...))
     def uniform_laplacian(fn):
-        M, C = matrix_pair(call(fn, V, F), n=len(V))
-        if close(C, -C_true):
-            raise Mistake("the sign of C is flipped", "C_ii = -valence, C_ij = +1 on edges")
-        ...
-        return ["one triangle", "a regular grid"]        # what was checked
+        cases = uniform_cases(case_rng())                  # placed anew each run
+        answers = run(fn, cases, matrix_pair)              # [(M, C), ...], or a Mistake for a wrong shape
+        judge(C_MISTAKES, cases, [C for _, C in answers], right=lambda c: c.C)
+        return [c.label for c in cases]                    # what was checked
 
 ``exercise`` turns the body into a function ``fn -> CheckResult``:
 
@@ -21,7 +21,19 @@ Writing a check::
 * ``NotImplementedError`` from the learner's function (the assignment's stub)
   -> ``passed=False``, "not written yet";
 * any other exception from the learner's function -> ``passed=False`` naming it;
+* an array handed to the learner's function and changed by it -> ``passed=False``, "the
+  function changed its input V in place" (``call`` compares every array argument after
+  each call; V is the learner's own name for it);
 * the body returning -> ``passed=True``, listing what was checked.
+
+Cases that vary from run to run
+-------------------------------
+``case_rng()`` is the generator a check places its cases with (a random similarity,
+a small jitter: ``check.meshes.placed``), from a fresh seed each time the check runs,
+so that answers learned from one run's inputs cannot be replayed. A check that drew it
+ends its message with the seed ("Cases seed 4182."); ``check.NAME(fn, seed=4182)`` or
+the environment variable ``GEOMLIB_CHECK_SEED`` runs those cases again. A right answer
+passes whatever the seed.
 
 Under the test suite's strict mode (``GEOMLIB_STRICT_CLAIMS=1``) a failed check
 of a function that is written (not a stub) raises ``CheckFailed``, so a
@@ -46,32 +58,51 @@ an exercise run on geomlib's own function in every mode.
 
 Ground rules
 ------------
-As in Jacobson's geometry-processing assignments, each exercise names the geomlib
-routines its answer may not call: its own routine, and whatever computes the answer
-for it (``exercise(..., forbid=("lessons.laplace.laplacian", ...))``, dotted names
-inside geomlib, a class standing for all its methods). While the learner's function
-runs, a profile hook watches for a call of any of them (through a lambda, a helper,
-a cache or another geomlib routine that calls it); one such call fails the check with
-no points, naming the routine. ``check.NAME.rules`` is the sentence the notebook and
-the grading guide print. ``reveal(fn, check.NAME)`` shows geomlib's own routine only
-once ``fn`` passes, so the page a student is handed never shows the answer. Warnings raised by the
-learner's function while nbgrader grades are silenced: nbgrader scores a grade
-cell that wrote to stderr as failed.
+The ground rules are an allow-list (``fence``): an answer may use numpy and scipy
+(``tools``; sympy in 02) and the geomlib routines its exercise hands it
+(``exercise(..., allow=("lessons.curvature.boundary_mask",))``); a call into any other
+geomlib routine or a geometry library (libigl, trimesh, ...) fails the check with no
+points, naming the routine. ``forbid`` names the routines that would compute the answer
+(quoted in the rules' sentence), ``own`` the exercise's own routine. ``check.NAME.rules``
+is the sentence the notebook and the grading guide print. ``reveal(fn, check.NAME)``
+shows geomlib's own routine only once ``fn`` passes, so the page a student is handed
+never shows the answer. Warnings raised by the learner's function while nbgrader grades
+are silenced: nbgrader scores a grade cell that wrote to stderr as failed.
+
+Where the points are decided
+----------------------------
+In the notebook the learner's function runs in the learner's kernel, so the check there
+(a profile hook in this thread and the threads it starts, an audit hook refusing
+``sys.setprofile``/``sys.settrace``, tripwires on libigl's compiled routines) is the
+student's interactive check: fast, with the same diagnoses, but code in the kernel can
+replace the check, its module or numpy. Under nbgrader the points are decided out of the
+kernel's reach: the preprocessor ``geomlib.teaching.grading.JudgeExercises`` runs after
+the notebook executed and hands each exercise to ``judge``, a fresh process holding the
+check and its reference answers, which calls the student's function in a ``sandbox``
+process through a pipe carrying plain data (arrays, sparse matrices as their components,
+sympy as its srepr). The sandbox runs only the notebook's imports and the solution cells,
+behind a fence the student's code cannot switch off (an audit hook ends the process on a
+forbidden entry, thread, process, setprofile or compile). ``copies`` flags a function whose
+syntax tree, names aside, is geomlib's routine (no points) or the solution notebook's
+(flagged for the grader). See docs/grading.md.
 """
 
 import contextlib
 import functools
 import html
-import importlib
 import inspect
+import os
+import secrets
 import sys
 import textwrap
+import threading
 import warnings
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..notebook import graded, strict_claims
+from .fence import Fence, cold_caches, resolve, untrip
 
 __all__ = [
     "CheckResult",
@@ -79,8 +110,7 @@ __all__ = [
     "Mistake",
     "exercise",
     "call",
-    "matrix_pair",
-    "vector",
+    "case_rng",
     "close",
     "use",
     "reveal",
@@ -158,62 +188,42 @@ class CheckResult:
         display({"text/plain": repr(self), "text/html": self._repr_html_()}, raw=True)
 
 
-def _resolve(dotted):
-    """The object a dotted name inside geomlib stands for ("lessons.laplace.laplacian")."""
-    module, _, name = dotted.rpartition(".")
-    return getattr(importlib.import_module(f"geomlib.{module}"), name)
+class Refused(Exception):
+    """The learner's function entered fenced code (``name``) or did what grading refuses (``why``)."""
 
-
-def _entry_points(dotted):
-    """{code object or id of a callable: public name} by which a call of ``dotted`` shows in a profile."""
-    target = _resolve(dotted)
-    members = [m for m in vars(target).values()] if isinstance(target, type) else [target]
-    found = {}
-    for member in members:
-        f = member.fget if isinstance(member, property) else getattr(member, "__func__", member)
-        if not callable(f):
-            continue
-        found[id(f)] = dotted  # a C-level wrapper (functools.lru_cache) shows as a "c_call" of itself
-        code = getattr(inspect.unwrap(f), "__code__", None)
-        if code is not None:
-            found[code] = dotted
-    return found
+    def __init__(self, name, why=""):
+        super().__init__(name)
+        self.name, self.why = name, why
 
 
 class _Rules:
-    """The ground rules of one exercise: the geomlib routines its answer may not call."""
+    """The ground rules of one exercise: an allow-list (the module docstring of ``fence``)."""
 
-    def __init__(self, forbid, own, allow=()):
-        self.forbid, self.own, self.allow = tuple(forbid), tuple(own), tuple(allow)
-        self._watch = None
-
-    def watch(self):
-        if self._watch is None:  # resolved on first use: a check module imports no lesson it forbids
-            self._watch = {}
-            for dotted in self.forbid:
-                self._watch.update(_entry_points(dotted))
-        return self._watch
+    def __init__(self, forbid, own, allow=(), tools=("numpy", "scipy")):
+        self.forbid, self.own, self.allow, self.tools = tuple(forbid), tuple(own), tuple(allow), tuple(tools)
+        self.fence = Fence(self.allow)
 
     def sentence(self):
-        if not self.forbid:
-            return "Any geomlib routine may be used."
-        names = ", ".join(f"`{_public(d)}`" for d in self.forbid)
-        tools = "numpy, scipy or sympy"
+        tools = ", ".join(self.tools[:-1]) + f" and {self.tools[-1]}"
         if self.allow:
-            tools += " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
-        return f"Ground rules: write it yourself with {tools}; do not call geomlib's {names}."
+            tools = ", ".join(self.tools) + " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
+        named = ", ".join(f"`{_public(d)}`" for d in self.forbid)
+        such = f" (such as {named})" if named else ""
+        return (
+            f"Ground rules: write it with {tools}. Any other geomlib routine{such}, a geometry library "
+            "(libigl, trimesh, gpytoolbox, ...) or a copy of geomlib's code earns no points."
+        )
 
-    def refusal(self, dotted):
-        why = (
-            "which this exercise asks you to write"
-            if dotted in self.own
-            else "which computes this exercise's answer for you"
-        )
-        return Mistake(
-            f"the function calls geomlib's `{_public(dotted)}`, {why}, so it earns no points",
-            self.sentence().rstrip("."),
-            typical=False,
-        )
+    def refusal(self, name, why=""):
+        if why:
+            diagnosis = f"the function {why}, which grading refuses, so it earns no points"
+        elif name.startswith("geomlib's") and name.split("`")[1] in {_public(d) for d in self.own}:
+            diagnosis = f"the function calls {name}, which this exercise asks you to write, so it earns no points"
+        elif name.startswith("geomlib's"):
+            diagnosis = f"the function calls {name}, which this exercise does not hand you, so it earns no points"
+        else:
+            diagnosis = f"the function calls {name}: a geometry library computes it for you, so it earns no points"
+        return Mistake(diagnosis, self.sentence().rstrip("."), typical=False)
 
 
 def _public(dotted):
@@ -221,95 +231,114 @@ def _public(dotted):
 
 
 _RULES = [None]  # the rules of the exercise being checked (checks run one at a time)
+_WATCHED = [None]  # while the learner's function runs in this process: the list its refusals go to
+
+
+def _audit(event, args):
+    """Refuse switching the watcher off while the learner's function runs (sys.addaudithook: for good)."""
+    hits = _WATCHED[0]
+    if hits is not None and event in ("sys.setprofile", "sys.settrace"):
+        hits.append(Refused(event, f"calls {event}, which would switch off the check's watcher"))
+        raise RuntimeError(f"{event} is refused while an exercise is checked")
+
+
+sys.addaudithook(_audit)
 
 
 @contextlib.contextmanager
-def _watching(watch, hits):
-    """Record the first forbidden routine entered while the block runs (sys.setprofile)."""
+def _watching(fence, hits, namespaces=()):
+    """Record the first entry into fenced code while the block runs, in this thread and the threads
+    it starts (sys.setprofile, threading.setprofile); wrap the geometry libraries' compiled routines."""
 
-    def profile(frame, event, arg):
-        if hits:
-            return
-        if event == "call":
-            name = watch.get(frame.f_code)
-        elif event == "c_call":
-            name = watch.get(id(arg))
-        else:
-            return
-        if name is not None:
-            hits.append(name)
+    def on_hit(name):
+        if not hits:
+            hits.append(Refused(name))
 
+    profile = fence.profile(on_hit)
+    cold_caches()
+    swapped = fence.tripwires(namespaces, on_hit)
     previous = sys.getprofile()
     sys.setprofile(profile)
+    threading.setprofile(profile)
+    _WATCHED[0] = hits
     try:
         yield
     finally:
+        _WATCHED[0] = None
+        threading.setprofile(None)
         sys.setprofile(previous)
+        untrip(swapped)
 
 
 def call(fn, *args):
-    """Call the learner's function under the exercise's ground rules; turn its exceptions into a diagnosis."""
-    rules, hits = _RULES[0], []
+    """Call the learner's function under the exercise's ground rules; turn its exceptions into a diagnosis,
+    and an array argument it changed in place into the mistake it is."""
+    rules, hits, before = _RULES[0], [], [_dense(a).copy() if _is_array(a) else None for a in args]
     try:
-        if rules is not None and rules.forbid:
-            with _watching(rules.watch(), hits):
+        if rules is not None:
+            with _watching(rules.fence, hits, [getattr(fn, "__globals__", {})]):
                 out = fn(*args)
         else:
             out = fn(*args)
+    except Refused as exc:  # reported by the grading sandbox
+        raise rules.refusal(exc.name, exc.why) from None
     except NotImplementedError as exc:
         if hits:
-            raise rules.refusal(hits[0]) from None
+            raise rules.refusal(hits[0].name, hits[0].why) from None
         raise _NotWritten(str(exc)) from None
     except Mistake:
         raise
     except Exception as exc:  # the learner's code may raise anything; name it
         if hits:
-            raise rules.refusal(hits[0]) from None
+            raise rules.refusal(hits[0].name, hits[0].why) from None
         raise Mistake(
-            f"the function raised {type(exc).__name__}: {exc}",
+            f"the function raised {getattr(exc, 'kind', type(exc).__name__)}: {exc}",
             "run it on the small example in the cell above and read the traceback",
             typical=False,
         ) from None
     if hits:
-        raise rules.refusal(hits[0])
+        raise rules.refusal(hits[0].name, hits[0].why)
+    for k, (a, kept) in enumerate(zip(args, before)):
+        if kept is not None and not np.array_equal(_dense(a), kept, equal_nan=kept.dtype.kind in "fc"):
+            name = _parameter(fn, k)
+            raise Mistake(
+                f"the function changed its input {name} in place",
+                f"work on a copy ({name} = {name}.copy()) or build a new array: the caller's {name} must stay as it was",
+            )
     return out
+
+
+def _is_array(a):
+    return isinstance(a, np.ndarray) or sp.issparse(a)
+
+
+def _parameter(fn, k):
+    """The name of the learner's k-th positional parameter (``V``), or "argument k + 1"."""
+    try:
+        names = [
+            p.name
+            for p in inspect.signature(fn).parameters.values()
+            if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+        ]
+    except (TypeError, ValueError):
+        names = []
+    return names[k] if k < len(names) else f"argument {k + 1}"
+
+
+SEED_VARIABLE = "GEOMLIB_CHECK_SEED"
+_SEED = {"asked": None, "used": None}  # of the check being run (checks run one at a time)
+
+
+def case_rng():
+    """The numpy Generator of the running check's cases: one seed per check run (see the module docstring)."""
+    if _SEED["used"] is None:
+        asked = _SEED["asked"] if _SEED["asked"] is not None else os.environ.get(SEED_VARIABLE, "")
+        _SEED["used"] = int(asked) if str(asked).strip() else secrets.randbelow(1_000_000)
+    return np.random.default_rng(_SEED["used"])
 
 
 def _dense(A):
     return A.toarray() if sp.issparse(A) else np.asarray(A)
-
-
-def matrix_pair(out, n):
-    """Check that ``out`` is a pair (M, C) of n x n matrices; return them dense as float arrays."""
-    if not isinstance(out, tuple) or len(out) != 2:
-        raise Mistake(
-            f"the function returned {type(out).__name__}, not the pair (M, C)",
-            "end with `return M, C`, M the diagonal mass matrix and C the weight matrix",
-            typical=False,
-        )
-    M, C = (_dense(A) for A in out)
-    for name, A in (("M", M), ("C", C)):
-        if A.shape == (n,) and name == "M":
-            raise Mistake("M is a vector, not a matrix", "return the diagonal matrix scipy.sparse.diags(areas)")
-        if A.shape != (n, n):
-            raise Mistake(
-                f"{name} has shape {A.shape}, expected ({n}, {n}) for a mesh with {n} vertices",
-                "one row and one column per vertex",
-                typical=False,
-            )
-    return M.astype(float), C.astype(float)
-
-
-def vector(out, n, what="the function"):
-    """Check that ``out`` is a length-n vector of numbers; return it as a float array."""
-    x = np.asarray(out, dtype=float) if not sp.issparse(out) else _dense(out).astype(float)
-    if x.shape not in ((n,), (n, 1), (1, n)):
-        raise Mistake(
-            f"{what} returned shape {x.shape}, expected ({n},): one value per vertex",
-            "return a flat numpy array with one entry per vertex",
-            typical=False,
-        )
-    return x.reshape(n)
 
 
 def close(a, b, rtol=1e-8, atol=1e-10):
@@ -334,24 +363,30 @@ def _enforce(result):
     return result
 
 
-def exercise(name, reread, forbid=(), own=None, allow=()):
+def _seed_said():
+    return "" if _SEED["used"] is None else f" Cases seed {_SEED['used']}."
+
+
+def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy")):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
 
-    ``forbid``: dotted names inside geomlib of the routines the answer may not call;
-    ``own``: those of them that are the exercise's own routine, revealed by ``reveal``
-    (default: the first); ``allow``: geomlib routines the exercise hands the student
-    (named in the ground rules' sentence; any routine not forbidden may be called).
+    The ground rules are an allow-list: the answer may use ``tools`` and the geomlib
+    routines ``allow`` names (dotted names inside geomlib); any other geomlib routine or a
+    geometry library is refused. ``forbid``: the routines that would compute the answer,
+    named in the rules' sentence; ``own``: those that are the exercise's own routine,
+    revealed by ``reveal`` (default: the first of ``forbid``).
     """
     overlap = set(forbid) & set(allow)
     if overlap:
         raise ValueError(f"exercise {name}: {sorted(overlap)} both forbidden and allowed")
-    rules = _Rules(forbid, forbid[:1] if own is None else own, allow)
+    rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools)
 
     def wrap(body):
-        def evaluate(fn):
-            """The CheckResult of ``fn``; never raises."""
+        def evaluate(fn, seed=None):
+            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises."""
             try:
                 _RULES[0] = rules
+                _SEED.update(asked=seed, used=None)
                 with _quiet_while_graded():
                     checked = body(fn)
             except _NotWritten as exc:
@@ -362,18 +397,24 @@ def exercise(name, reread, forbid=(), own=None, allow=()):
                 return CheckResult(name, False, message, written=False)
             except Mistake as m:
                 message = f"{m.diagnosis}." + (f" Hint: {m.hint}." if m.hint else "") + f" Reread {reread}."
-                return CheckResult(name, False, message, partial=m.typical)
+                return CheckResult(name, False, message + _seed_said(), partial=m.typical)
+            except Exception as exc:  # what came back could not be read as an answer: no points, never a crash
+                message = (
+                    f"what the function returned could not be read as an answer ({type(exc).__name__}: {exc}). "
+                    f"Hint: return what the exercise asks for, of the shape it states. Reread {reread}."
+                )
+                return CheckResult(name, False, message + _seed_said(), partial=False)
             finally:
                 _RULES[0] = None
-            return CheckResult(name, True, "checked on " + ", ".join(checked) + ".")
+            return CheckResult(name, True, "checked on " + ", ".join(checked) + "." + _seed_said())
 
         @functools.wraps(body)
-        def check(fn):
-            return _enforce(evaluate(fn))
+        def check(fn, seed=None):
+            return _enforce(evaluate(fn, seed))
 
-        def partial_credit(fn):
+        def partial_credit(fn, seed=None):
             """Partial credit: ``fn`` is right, or the first thing wrong is a typical mistake the check names."""
-            result = evaluate(fn)
+            result = evaluate(fn, seed)
             if result.passed:
                 message = "earned: the function passes its check."
             elif result.partial:
@@ -423,8 +464,8 @@ def reveal(fn, check):
     if result.passed:
         print(f"Your {getattr(fn, '__name__', 'function')} passes its check. geomlib's own, to compare with yours:")
         for dotted in check.own[1:]:
-            display(show_source(_resolve(dotted)))
-        return show_source(_resolve(check.own[0]))
+            display(show_source(resolve(dotted)))
+        return show_source(resolve(check.own[0]))
     print(
         f"geomlib's own {_public(check.own[0])} is shown here once your "
         f"{getattr(fn, '__name__', 'function')} passes its check above: write yours first."

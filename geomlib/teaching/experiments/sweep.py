@@ -23,14 +23,14 @@ import warnings
 import numpy as np
 import scipy.sparse as sp
 
-from ..lessons.laplace import WEIGHTS
-from ..lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
-from ..lessons.noise import add_noise
-from ..lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmoother, explicit_step_limit
-from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.geometry import bounding_box_diagonal
-from ..mesh.validate import check_choice
-from ..numerics.cores import CORES
+from ...lessons.laplace import WEIGHTS
+from ...lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
+from ...lessons.noise import add_noise
+from ...lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmoother, explicit_step_limit
+from ...mesh.errors import MeshError, MeshWarning
+from ...mesh.geometry import bounding_box_diagonal
+from ...mesh.validate import check_choice
+from ...numerics.cores import CORES
 from .steps import absolute_step
 
 __all__ = [
@@ -47,8 +47,6 @@ __all__ = [
     "COMPARISON_GRIDS",
     "DenoisingComparison",
     "denoising_comparison",
-    "plot_comparison",
-    "plot_taubin_factors",
 ]
 
 #: The smoothing methods a scheme can name.
@@ -180,19 +178,11 @@ class SmoothingSweep:
 
 
 def smoothing_sweep(
-    V_clean,
-    F,
-    sigmas,
-    seed,
-    schemes=SCHEMES,
-    explicit_fractions=EXPLICIT_FRACTIONS,
-    implicit_steps=IMPLICIT_STEPS,
-    iterations=SWEEP_ITERATIONS,
-    direction="isotropic",
-    comparison=None,
-    progress=True,
-    workers=None,
-):
+    V_clean, F, sigmas, seed,  # the mesh and its noise
+    schemes=SCHEMES, explicit_fractions=EXPLICIT_FRACTIONS, implicit_steps=IMPLICIT_STEPS,  # the grid
+    iterations=SWEEP_ITERATIONS, direction="isotropic",
+    comparison=None, progress=True, workers=None,  # the run
+):  # fmt: skip
     """Add noise at each level, smooth it with every scheme, step and iteration count, measure.
 
     For every noise level ``sigma`` (a fraction of the bounding-box
@@ -237,7 +227,8 @@ def smoothing_sweep(
     -------
     SmoothingSweep
     """
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    if comparison is None:
+        comparison = MeshComparison(V_clean, F)
     iterations = np.asarray(sorted(set(int(k) for k in iterations)), dtype=np.int64)
     if len(iterations) == 0 or iterations[0] < 1:
         raise MeshError("iterations must be positive whole numbers")
@@ -254,7 +245,7 @@ def smoothing_sweep(
         bar = tqdm(total=runs, desc="smoothing sweep")
 
     def sweep(levels, bar):
-        _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterations, bar)
+        _sweep_levels(comparison, out, levels, seed, direction, schemes, step_values, iterations, bar)
 
     def rows(levels):
         found = {("values", k): v[levels] for k, v in out.values.items()}
@@ -286,7 +277,7 @@ def _run_levels(sweep, rows, put, count, out, bar, workers):
     out.seconds = time.perf_counter() - start
 
 
-def _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterations, bar):
+def _sweep_levels(comparison, out, levels, seed, direction, schemes, step_values, iterations, bar):
     """The runs of :func:`smoothing_sweep` at the noise levels ``levels`` (indices), recorded into ``out``."""
     where = {int(k): l for l, k in enumerate(iterations)}
     last = int(iterations[-1])
@@ -294,22 +285,22 @@ def _sweep_levels(C, out, levels, seed, direction, schemes, step_values, iterati
     # M - step C, serves every noise level (it smooths each noisy mesh from P = Vn)
     shared = {}
     for i in levels:
-        Vn = add_noise(C.V_clean, C.F, out.sigmas[i], seed, direction=direction)
-        for key, value in C.evaluate(Vn, hausdorff=False).items():
+        Vn = add_noise(comparison.V_clean, comparison.F, out.sigmas[i], seed, direction=direction)
+        for key, value in comparison.evaluate(Vn, hausdorff=False).items():
             out.noisy[key][i] = value
         for j, (method, weights) in enumerate(schemes):
             smoother = shared.get((method, weights))
             if smoother is None:
-                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, C.F, weights)
+                smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(Vn, comparison.F, weights)
                 if method == "implicit" and weights == "uniform":
                     shared[method, weights] = smoother
             for k, value in enumerate(step_values[method]):
-                step = scale_free_step(Vn, C.F, method, weights, value)
+                step = scale_free_step(Vn, comparison.F, method, weights, value)
                 out.steps[i, j, k] = step
 
                 def record(it, P, i=i, j=j, k=k):
                     if it in where:
-                        for name, v in C.evaluate(P, hausdorff=False).items():
+                        for name, v in comparison.evaluate(P, hausdorff=False).items():
                             out.values[name][i, j, k, where[it]] = v
 
                 with warnings.catch_warnings():
@@ -464,7 +455,8 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     for method, weights in grids:
         check_choice("method", method, METHODS + ("taubin",))
         check_choice("weights", weights, WEIGHTS)
-    C = comparison if comparison is not None else MeshComparison(V_clean, F)
+    if comparison is None:
+        comparison = MeshComparison(V_clean, F)
     out = DenoisingComparison(sigmas, grids)
     for steps, counts in out.grids.values():
         if not steps or not counts or min(counts) < 1 or min(steps) <= 0:
@@ -475,7 +467,7 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
 
     def sweep(indices, bar):
         for i, j in (jobs[x] for x in indices):
-            _compare(C, out, i, j, seed)
+            _compare(comparison, out, i, j, seed)
 
     def rows(indices):
         found = {}
@@ -499,21 +491,21 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     return out
 
 
-def _compare(C, out, i, j, seed):
+def _compare(comparison, out, i, j, seed):
     """The runs of :func:`denoising_comparison` of method ``j`` at noise level ``i``, recorded into ``out``."""
-    W = add_noise(C.V_clean, C.F, out.sigmas[i], seed)
-    for key, value in C.evaluate(W, hausdorff=False).items():
+    W = add_noise(comparison.V_clean, comparison.F, out.sigmas[i], seed)
+    for key, value in comparison.evaluate(W, hausdorff=False).items():
         if key in out.noisy:
             out.noisy[key][i] = value
     (method, weights), (steps, counts) = out.methods[j], out.grids[out.methods[j]]
-    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, C.F, weights)
-    out.limits[i, j] = limit = explicit_step_limit(W, C.F, weights)
+    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, comparison.F, weights)
+    out.limits[i, j] = limit = explicit_step_limit(W, comparison.F, weights)
     where = {k: l for l, k in enumerate(counts)}
     for k, fraction in enumerate(steps):
 
         def record(it, P, k=k):
             if it in where:
-                for key, value in C.evaluate(P, hausdorff=False).items():
+                for key, value in comparison.evaluate(P, hausdorff=False).items():
                     if key in out.values:
                         out.values[key][j][i, k, where[it]] = value
 
@@ -544,105 +536,3 @@ def _taubin(smoother, W, tau, counts, callback):
             if not np.abs(P - W).max() <= far:
                 return
             callback(k, P)
-
-
-#: How the comparison's heat maps name each metric on their colour bar.
-COMPARISON_LABELS = {
-    "rms": "E: vertex RMS error / d",
-    "normal_mean": "mean face-normal error (degrees)",
-    "volume_change": "|volume change| (fraction)",
-}
-
-
-def plot_comparison(result, i, key="rms"):
-    """Heat maps of :func:`denoising_comparison` at noise level ``i``: one panel per method.
-
-    Each panel: ``key`` over (step, iteration count), in one unit on every panel (y: the step
-    as a fraction of the explicit limit of the method's operator; x: iterations, Taubin's
-    pairs), on one log colour scale for all panels in the metric's own unit, the unit of the
-    number written at each panel's best cell (ringed); the noisy input's value is marked on
-    the colour bar, so a cell darker than the mark improved on the input. Returns
-    ``(fig, alt)``, the alt text built from the plotted numbers.
-    """
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
-
-    noisy = float(result.noisy[key][i])
-    shown = [np.abs(v[i]) for v in result.values[key]]
-    found = np.concatenate([x[np.isfinite(x) & (x > 0)] for x in shown] + [np.array([noisy] if noisy > 0 else [])])
-    lo, hi = (float(found.min()), float(found.max())) if found.size else (1.0, 1.0)
-    norm = LogNorm(vmin=lo, vmax=max(hi, 10 * lo))
-    fig, axes = plt.subplots(1, len(result.methods), figsize=(3.6 * len(result.methods), 3.3), squeeze=False)
-    found, edge = [], []
-    for ax, (method, weights), values in zip(axes[0], result.methods, shown):
-        steps, counts = result.grids[method, weights]
-        im = ax.imshow(values, cmap="viridis", norm=norm, aspect="auto", origin="lower")
-        b = result.best(i, (method, weights), key)
-        k, l = b["index"]
-        ax.plot(l, k, "o", ms=14, mfc="none", mec="white", mew=2)
-        side = "center" if 0 < l < len(counts) - 2 else ("left" if l == 0 else "right")  # kept inside the panel
-        shift = {"center": 0, "left": -8, "right": 8}[side]
-        ax.annotate(f"{b[key]:.3g}", (l, k), xytext=(shift, 11), textcoords="offset points", ha=side, color="white")
-        ticks = range(0, len(counts), -(-len(counts) // 5))  # at most five labels: they must not run together
-        ax.set_xticks(list(ticks), [str(counts[c]) for c in ticks])
-        ax.set_yticks(range(len(steps)), [f"{s:g}" for s in steps])
-        ax.set_xlabel("shrink/inflate pairs" if method == "taubin" else "iterations")
-        ax.set_title(f"{method}, {weights}", fontsize=10)
-        found.append(f"{method} {weights} {b[key]:.3g} at {b['fraction']:g} of the limit, {b['iterations']} iterations")
-        if not b["inside"]:
-            edge.append(f"{method} {weights}")
-    axes[0, 0].set_ylabel("step / explicit limit")
-    name = COMPARISON_LABELS.get(key, key)
-    bar = fig.colorbar(im, ax=axes, label=f"{name} (log scale)", shrink=0.9)
-    if noisy > 0:  # the input every setting has to beat, on the same scale
-        bar.ax.axhline(noisy, color="black", lw=2)
-        bar.ax.annotate("noisy\ninput", (0, noisy), xytext=(-4, 0), textcoords="offset points", ha="right", va="center")
-    fig.suptitle(f"noise sigma = {result.sigmas[i]:g}: {name} after smoothing, over step and iterations", y=1.04)
-    alt = (
-        f"{len(result.methods)} heat maps at noise sigma {result.sigmas[i]:g}, one per method, of {name} over the "
-        f"step (as a fraction of the explicit limit) and the iteration count, from {lo:.3g} to {hi:.3g} on one log "
-        f"colour scale; the noisy input's {noisy:.3g} is marked on the colour bar. Each method's smallest value ("
-        + (f"on its grid's edge for {' and '.join(edge)}" if edge else "inside its grid")
-        + "): "
-        + "; ".join(found)
-        + "."
-    )
-    return fig, alt
-
-
-def plot_taubin_factors(lam_max, tau_shrink, tau_inflate, low):
-    """One Taubin pair against two explicit steps of ``tau_shrink``: the factor per mode over [0, lam_max].
-
-    Lines told apart by style and marker, each labelled; the smooth mode ``low`` marked on both.
-    Returns ``(fig, alt)``, the alt text built from the plotted factors.
-    """
-    import matplotlib.pyplot as plt
-
-    from ..lessons.filters import mode_factor
-
-    lam = np.linspace(0.0, lam_max, 200)
-    pair = mode_factor(lam, tau_shrink, "taubin", tau_inflate)
-    two = mode_factor(lam, tau_shrink, "explicit") ** 2
-    fig, ax = plt.subplots(figsize=(7, 3.4))
-    ax.plot(lam, pair, "-", lw=2, label=f"one Taubin pair ({tau_shrink:g}, {tau_inflate:g})")
-    ax.plot(lam, two, "--", lw=2, label=f"two explicit steps of {tau_shrink:g}")
-    at = [
-        float(mode_factor(low, tau_shrink, "taubin", tau_inflate)),
-        float(mode_factor(low, tau_shrink, "explicit")) ** 2,
-    ]
-    ax.plot([low, low], at, "ko", ms=5)
-    for y, text in zip(at, ("pair", "explicit")):
-        ax.annotate(
-            f"{text}: {y:.3f}", (low, y), xytext=(6, -4 if text == "explicit" else 4), textcoords="offset points"
-        )
-    ax.axhline(0, color="0.5", lw=0.6)
-    ax.set(
-        xlabel=r"eigenvalue $\lambda$ (0: smooth shape, right: fine wiggles)", ylabel="factor kept", xlim=(0, lam_max)
-    )
-    ax.legend(loc="lower left", fontsize=9)
-    alt = (
-        f"Factor kept per mode over the eigenvalues 0 to {lam_max:.3g}: one Taubin pair ({tau_shrink:g}, {tau_inflate:g}) "
-        f"keeps {at[0]:.3f} of the smooth mode at {low:.3g} where two explicit steps keep {at[1]:.3f}; at the top "
-        f"mode the pair keeps {float(pair[-1]):.3f} and the explicit steps {float(two[-1]):.3f}."
-    )
-    return fig, alt

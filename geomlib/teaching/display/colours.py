@@ -13,7 +13,7 @@ import html
 
 import numpy as np
 
-from ..mesh.errors import MeshError
+from ...mesh.errors import MeshError
 
 __all__ = [
     "NAN_COLOR",
@@ -68,8 +68,8 @@ def plot_style():
 
 
 def use_plot_style():
-    """Make :func:`plot_style` matplotlib's default for this session (importing the 3D
-    viewer in a notebook does it)."""
+    """Make :func:`plot_style` matplotlib's default for this session (:func:`geomlib.setup_display`,
+    which each notebook's set-up cell calls, does it)."""
     import matplotlib
 
     matplotlib.rcParams.update(plot_style())

@@ -3,8 +3,8 @@
 Google Colab renders ipywidgets' own controls out of the box, but loads a
 third-party widget's JavaScript (here pythreejs, ``jupyter-threejs``) only
 after ``google.colab.output.enable_custom_widget_manager()`` was called in the
-session. ``import geomlib`` makes that call when it runs inside Colab, so
-every notebook's set-up cell is enough there. Colab is recognised by its
+session. :func:`geomlib.setup_display` makes that call when it runs inside Colab;
+every notebook's set-up cell calls it, and so does the first 3D view. Colab is recognised by its
 module ``google.colab``; everywhere else nothing happens.
 
 JupyterLab, Notebook 7 and VS Code need nothing from the kernel (VS Code

@@ -47,7 +47,7 @@ _MEMORY = OrderedDict()
 def folder(cache_dir=None):
     """The folder holding cached eigenbases (it need not exist yet).
 
-    Order: the ``cache_dir`` argument, ``geomlib.numerics.cache.CACHE_DIR``, the
+    Order: the ``cache_dir`` argument, ``geomlib.numerics.eigenbasis_store.CACHE_DIR``, the
     environment variable ``GEOMLIB_CACHE_DIR``, the per-user cache folder
     (``$XDG_CACHE_HOME/geomlib``, default ``~/.cache/geomlib``, on Linux;
     ``~/Library/Caches/geomlib`` on macOS; ``%LOCALAPPDATA%\\geomlib\\Cache`` on

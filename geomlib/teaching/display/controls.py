@@ -7,7 +7,7 @@ update and shows a read-out line under the controls: the text ``update``
 returns, the warnings the run raised (a diverging run's ``MeshWarning``), and
 the time it took.
 
-    steps = log_slider(STEP, lo, hi, "τ / ℓ²")      # geomlib.teaching.steps
+    steps = log_slider(STEP, lo, hi, "τ / ℓ²")      # geomlib.teaching.experiments.steps
     n = ipywidgets.IntSlider(30, min=0, max=300, description="iterations", continuous_update=False)
 
     def update(step, iterations):
@@ -18,7 +18,7 @@ the time it took.
     live(update, {"step": steps, "iterations": n}, view)
 
 The controls are real ipywidgets and the views real :class:`MeshView` widgets in
-one box, as the browser tests and the website expect (geomlib/teaching/viewer.py
+one box, as the browser tests and the website expect (geomlib/teaching/display/viewer.py
 says how they find them). ``mesh_warnings(run, ...)`` gives the same read-out of
 warnings for a run outside a live cell.
 """
@@ -27,7 +27,7 @@ import html
 import time
 import warnings
 
-from ..mesh.errors import MeshError, MeshWarning
+from ...mesh.errors import MeshError, MeshWarning
 from .stills import png_base64
 from .viewer import MeshView, ViewRow, box_alt, box_still, stills_only
 

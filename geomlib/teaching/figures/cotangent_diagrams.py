@@ -15,12 +15,11 @@ areas are the mixed areas.
 
 import numpy as np
 
-from ..lessons.laplace import barycentric_areas, face_geometry
-from ..mesh.errors import MeshError
-from ..mesh.topology import boundary_vertices, one_ring
-from ..mesh.validate import as_mesh
-from . import surfaces
-from .check.areas import voronoi_pieces
+from ...lessons.laplace import barycentric_areas, face_geometry, voronoi_pieces
+from ...mesh.errors import MeshError
+from ...mesh.topology import boundary_vertices, one_ring
+from ...mesh.validate import as_mesh
+from ..shapes import surfaces
 
 __all__ = [
     "hat_gradients",

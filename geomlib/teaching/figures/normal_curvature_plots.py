@@ -10,7 +10,7 @@ compiled formulas and the implicit equation x^2/a^2 + y^2/b^2 + z^2/c^2 = 1.
 
 import numpy as np
 
-from ..lessons.symbolic import ellipsoid
+from ...lessons.symbolic import ellipsoid
 
 __all__ = ["normal_section", "normal_section_figure", "polar_and_dupin_figure", "kappa_turn_figure"]
 
@@ -156,7 +156,7 @@ def kappa_turn_figure(a, b, c, swapped=False):
     """
     import matplotlib.pyplot as plt
 
-    from ..lessons.symbolic import ellipsoid_normal_curvature
+    from ...lessons.symbolic import ellipsoid_normal_curvature
 
     phis = np.linspace(0, 2 * np.pi, 361)
     kappa = ellipsoid_normal_curvature(a, b, c, phis)

@@ -9,11 +9,12 @@ distance, orientation) and the vertex normals are shared with the live view
 """
 
 import base64
+import functools
 import io
 
 import numpy as np
 
-from ..mesh.geometry import bounding_box_diagonal, vertex_normals
+from ...mesh.geometry import bounding_box_diagonal, vertex_normals
 from .colours import format_value
 
 __all__ = [
@@ -26,6 +27,9 @@ __all__ = [
     "camera_distance",
     "camera_basis",
     "render_still",
+    "draw_edges",
+    "still_font",
+    "drawable",
     "draw_words",
     "still_with_colorbar",
     "in_a_row",
@@ -107,6 +111,7 @@ def render_still(
     background=(1.0, 1.0, 1.0),
     centre=None,
     cull_back=False,
+    edges=None,
 ):
     """Draw the mesh as the viewer's camera first sees it, into an RGB image.
 
@@ -119,7 +124,8 @@ def render_still(
     the 3D view, shaded by the same head light (|n . e|, both sides lit), and
     every triangle's pixel centres are found row by row (:func:`fragments`);
     the nearest candidate per pixel wins (depth tested with interpolated 1/z).
-    Colours are interpolated (Gouraud).
+    Colours are interpolated (Gouraud). ``edges`` (k, 2) int64 vertex pairs are
+    drawn over the surface as the live view's wireframe draws them (:func:`draw_edges`).
 
     Returns
     -------
@@ -150,13 +156,54 @@ def render_still(
     pix, face, b0, b1 = fragments(sx[F], sy[F], inv[F], width, height, cull_back)
     image = np.empty((height * width, 3), dtype=np.float64)
     image[:] = background
+    nearest = np.full(height * width, -np.inf)  # 1/depth of the surface drawn at each pixel
     if pix.size:
         # colours of the winning fragments only: under the spikes of an unstable run most
         # fragments are hidden, and interpolating their colours took half the time
         ff = F[face]
         b2 = 1.0 - b0 - b1
         image[pix] = b0[:, None] * vc[ff[:, 0]] + b1[:, None] * vc[ff[:, 1]] + b2[:, None] * vc[ff[:, 2]]
+        nearest[pix] = b0 * inv[ff[:, 0]] + b1 * inv[ff[:, 1]] + b2 * inv[ff[:, 2]]
+    if edges is not None and len(edges):
+        draw_edges(image, nearest, sx, sy, inv, np.asarray(edges, dtype=np.int64), width, height, 0.01 * radius)
     return (np.clip(image, 0.0, 1.0) * 255 + 0.5).astype(np.uint8).reshape(height, width, 3)
+
+
+#: the live view's wireframe: lines of this colour at this opacity over the surface
+EDGE_COLOR = (0x1A / 255, 0x1A / 255, 0x1A / 255)
+EDGE_OPACITY = 0.45
+
+
+def draw_edges(image, nearest, sx, sy, inv, E, width, height, slack):
+    """Blend the edges ``E`` (k, 2) into ``image`` (h * w, 3) float where the surface does not hide them.
+
+    Each edge is sampled about every half pixel between its projected ends
+    (``sx``, ``sy``); 1/depth is linear along it on the screen, as on a triangle.
+    A sample is drawn when nothing nearer than ``slack`` (length units) in front
+    of it was drawn at its pixel: the edges lie on the surface, and the slack
+    plays the part of the live view's polygon offset (the faces pushed back a
+    little so that their own edges win the depth test). Every covered pixel is
+    blended once, ``EDGE_OPACITY`` of ``EDGE_COLOR``, as the live view's lines.
+    """
+    x0, y0, x1, y1 = sx[E[:, 0]], sy[E[:, 0]], sx[E[:, 1]], sy[E[:, 1]]
+    onscreen = (np.maximum(x0, x1) >= 0) & (np.minimum(x0, x1) < width) & (np.maximum(y0, y1) >= 0)
+    onscreen &= np.minimum(y0, y1) < height
+    E = E[onscreen]
+    x0, y0, x1, y1 = x0[onscreen], y0[onscreen], x1[onscreen], y1[onscreen]
+    count = np.ceil(2 * np.hypot(x1 - x0, y1 - y0)).astype(np.int64) + 1
+    owner, offset = _runs(count)
+    t = offset / np.maximum(count[owner] - 1, 1)
+    x = x0[owner] + t * (x1 - x0)[owner]
+    y = y0[owner] + t * (y1 - y0)[owner]
+    key = (1 - t) * inv[E[owner, 0]] + t * inv[E[owner, 1]]
+    px, py = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    inside = (px >= 0) & (px < width) & (py >= 0) & (py < height)
+    pix, key = py[inside] * width + px[inside], key[inside]
+    front = nearest[pix]
+    seen = front == -np.inf  # no surface at the pixel
+    seen[~seen] = 1.0 / key[~seen] <= 1.0 / front[~seen] + slack
+    pix = np.unique(pix[seen])
+    image[pix] = (1 - EDGE_OPACITY) * image[pix] + EDGE_OPACITY * np.asarray(EDGE_COLOR)
 
 
 def fragments(X, Y, inv, width, height, cull_back=False, budget=2_000_000):
@@ -252,6 +299,29 @@ def _row_lines(X, Y, inv, area, cy):
 # ----------------------------------------------------------------------------
 
 
+@functools.lru_cache(maxsize=1)
+def still_font():
+    """The font of the stills' titles and colour bars: DejaVu Sans at 11 px, from matplotlib's own files.
+
+    Pillow's default font (Aileron) has no superscript two, no Greek and no minus
+    sign: "K (1/length²)" came out with a box for the "²". DejaVu Sans covers
+    Latin, Greek and the mathematical signs the labels use, and every install of
+    the workbook has it (matplotlib ships it).
+    """
+    from matplotlib import font_manager
+    from PIL import ImageFont
+
+    path = font_manager.findfont(font_manager.FontProperties(family="DejaVu Sans"), fallback_to_default=True)
+    return ImageFont.truetype(path, 11)
+
+
+def drawable(text, font=None):
+    """The characters of ``text`` that ``font`` (default :func:`still_font`) has no glyph for (drawn as boxes)."""
+    font = still_font() if font is None else font
+    box = np.asarray(font.getmask("\uffff"))  # what a character without a glyph becomes
+    return sorted({ch for ch in text if not ch.isspace() and np.array_equal(np.asarray(font.getmask(ch)), box)})
+
+
 def draw_words(draw, xy, text, font, fill=(20, 20, 20)):
     """Draw ``text`` word by word, a third of the font size apart.
 
@@ -272,7 +342,7 @@ def draw_words(draw, xy, text, font, fill=(20, 20, 20)):
 
 def still_with_colorbar(image, lut, vmin, vmax, label, title):
     """Add the title above and a colour bar with its range below the still picture."""
-    from PIL import Image, ImageDraw, ImageFont
+    from PIL import Image, ImageDraw
 
     h, w = image.shape[:2]
     top = 18 if title else 0
@@ -280,22 +350,22 @@ def still_with_colorbar(image, lut, vmin, vmax, label, title):
     canvas = Image.new("RGB", (w, h + top + bottom), "white")
     canvas.paste(Image.fromarray(image), (0, top))
     draw = ImageDraw.Draw(canvas)
-    font = ImageFont.load_default()
+    font = still_font()
     if title:
         draw_words(draw, (4, 3), title, font)
     if lut is not None:
         lo, hi = format_value(vmin), format_value(vmax)
-        x0, x1 = 8 + 7 * len(lo), w - 8 - 7 * len(hi)
+        x0, x1 = 10 + round(font.getlength(lo)), w - 10 - round(font.getlength(hi))
         y = h + top + 6
         if x1 > x0:
             t = np.linspace(0, 1, x1 - x0)
             strip = (lut[np.round(t * (len(lut) - 1)).astype(int)] * 255).astype(np.uint8)
             canvas.paste(Image.fromarray(np.repeat(strip[None], 10, axis=0)), (x0, y))
             draw.rectangle([x0 - 1, y - 1, x1, y + 10], outline=(120, 120, 120))
-        draw.text((4, y), lo, fill=(20, 20, 20), font=font)
-        draw.text((x1 + 4, y), hi, fill=(20, 20, 20), font=font)
+        draw.text((4, y - 1), lo, fill=(20, 20, 20), font=font)
+        draw.text((x1 + 4, y - 1), hi, fill=(20, 20, 20), font=font)
         if label:
-            draw_words(draw, (w // 2 - 3 * len(label), y + 14), label, font)
+            draw_words(draw, (max(4, (w - font.getlength(label)) // 2), y + 13), label, font)
     return np.asarray(canvas)
 
 

@@ -14,7 +14,7 @@ surface as long as their number stays the same.
 
 import numpy as np
 
-from ..mesh.errors import MeshError
+from ...mesh.errors import MeshError
 
 __all__ = ["arrow_meshes", "marker_meshes", "Glyphs"]
 

@@ -8,9 +8,9 @@ positive (the vertex of a bowl or a sphere), an overlap when negative (a saddle-
 
 import numpy as np
 
-from ..mesh.errors import MeshError
-from ..mesh.topology import boundary_vertices, one_ring
-from ..mesh.validate import as_mesh
+from ...mesh.errors import MeshError
+from ...mesh.topology import boundary_vertices, one_ring
+from ...mesh.validate import as_mesh
 
 __all__ = ["unfolded_fan", "angle_fan_figure"]
 

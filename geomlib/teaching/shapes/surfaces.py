@@ -48,9 +48,9 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import face_cross, zero_area_faces
-from ..mesh.validate import check_choice
+from ...mesh.errors import MeshError, format_indices
+from ...mesh.geometry import face_cross, zero_area_faces
+from ...mesh.validate import check_choice
 
 __all__ = [
     "AnalyticMesh",
@@ -136,25 +136,12 @@ class AnalyticMesh:
             out[key] = a
         return out
 
-    @property
-    def N(self) -> np.ndarray:
-        return self._values["N"]
-
-    @property
-    def H(self) -> np.ndarray:
-        return self._values["H"]
-
-    @property
-    def K(self) -> np.ndarray:
-        return self._values["K"]
-
-    @property
-    def k1(self) -> np.ndarray:
-        return self._values["k1"]
-
-    @property
-    def k2(self) -> np.ndarray:
-        return self._values["k2"]
+    # the exact values, computed together on the first access to any of them
+    N = property(lambda self: self._values["N"], doc="(n, 3) exact outward (upward) unit normal")
+    H = property(lambda self: self._values["H"], doc="(n,) exact mean curvature (1/length)")
+    K = property(lambda self: self._values["K"], doc="(n,) exact Gaussian curvature (1/length^2)")
+    k1 = property(lambda self: self._values["k1"], doc="(n,) exact larger principal curvature (1/length)")
+    k2 = property(lambda self: self._values["k2"], doc="(n,) exact smaller principal curvature (1/length)")
 
     @property
     def n_vertices(self) -> int:
@@ -286,6 +273,17 @@ def _grid_jitter(rng, shape, jitter, fixed_u=None, fixed_v=None):
     return du, dv
 
 
+def _jittered_grid(count, rows, du, dv, jitter, seed):
+    """(u, v) of the grid points (du i, dv j), i in 0..count-1 and j in ``rows``, ravelled i-major,
+    each moved by up to ``jitter`` grid steps (:func:`_grid_jitter`)."""
+    i, j = np.meshgrid(np.arange(count), rows, indexing="ij")
+    u, v = (du * i).ravel(), (dv * j).ravel()
+    if jitter > 0:
+        ou, ov = _grid_jitter(_rng(seed), u.shape, jitter)
+        u, v = u + du * ou, v + dv * ov
+    return u, v
+
+
 def _make(name, params, V, F, uv, closed, truth, area=None, volume=None):
     if uv is not None:
         uv = np.ascontiguousarray(uv, dtype=np.float64)
@@ -331,7 +329,7 @@ def _symbolic_surface(kind, params):
     derived without simplifying (the same values, a fraction of the time)."""
     import sympy as sp
 
-    from ..lessons import symbolic
+    from ...lessons import symbolic
 
     if kind == "ellipsoid":
         return symbolic.ellipsoid(*params, simplify=False)
@@ -438,8 +436,9 @@ def saddle_height(x, y, amplitude=0.2, monkey=0.1):
     ``A = amplitude`` (the height of the bumps: ``x (1 - x^2)`` peaks at
     ``2 / (3 sqrt 3)``, hence the factor 27/4), ``B = monkey``. On the square
     [-1, 1]^2 (``size = 2``) the first term has two bumps, two dips, a saddle
-    at the origin and four more on the boundary, like
-    ``sin(pi x) sin(pi y)``; the monkey-saddle term breaks the symmetry.
+    at the origin and eight more on the boundary (the four edge midpoints and
+    the four corners), like ``sin(pi x) sin(pi y)``; the monkey-saddle term
+    breaks the symmetry.
     A polynomial, so that its exact curvature is a rational expression.
     x, y, z in the same length units.
     """
@@ -645,20 +644,15 @@ def sphere(r=1.0, subdivisions=3, jitter=0.0, seed=0):
     if jitter > 0:
         P = _sphere_jitter(P, F, jitter, seed)
     V = r * P
-    _check_faces(V, F, P, "sphere")
     params = dict(r=r, subdivisions=subdivisions, jitter=jitter, seed=seed)
-    truth = _constant_truth(V.shape[0], P, 1.0 / r, 1.0 / r**2)
-    return _make(
-        "sphere",
-        params,
-        V,
-        F,
-        _ellipsoid_uv(V, r, r, r),
-        True,
-        truth,
-        area=4.0 * np.pi * r * r,
-        volume=4.0 / 3.0 * np.pi * r**3,
-    )
+    return _sphere_mesh(params, V, F, P, _ellipsoid_uv(V, r, r, r), r, "sphere")
+
+
+def _sphere_mesh(params, V, F, N, uv, r, what):
+    """The AnalyticMesh of a sphere of radius r, its exact truth constant: N outward, H = 1/r, K = 1/r^2."""
+    _check_faces(V, F, N, what)
+    truth = _constant_truth(V.shape[0], N, 1.0 / r, 1.0 / r**2)
+    return _make("sphere", params, V, F, uv, True, truth, area=4.0 * np.pi * r * r, volume=4.0 / 3.0 * np.pi * r**3)
 
 
 def _ellipsoid_mesh(params, V, F, uv):
@@ -712,13 +706,7 @@ def _uv_ellipsoid_mesh(a, b, c, n, jitter, seed):
     per pole (fans of triangles there, no degenerate quads)."""
     nu, nv = 2 * n, n
     du, dv = 2.0 * np.pi / nu, np.pi / nv
-    i, j = np.meshgrid(np.arange(nu), np.arange(1, nv), indexing="ij")  # ring j = 1..n-1
-    u = (du * i).ravel()
-    v = (dv * j).ravel()
-    if jitter > 0:
-        ou, ov = _grid_jitter(_rng(seed), u.shape, jitter)
-        u = u + du * ou
-        v = v + dv * ov
+    u, v = _jittered_grid(nu, np.arange(1, nv), du, dv, jitter, seed)  # ring j = 1..n-1
     # vertex order: north pole, rings (ring-major by longitude i), south pole
     # grid index of (i, j) is i * (nv - 1) + (j - 1) + 1
     u = np.concatenate([[0.0], u, [0.0]])
@@ -770,21 +758,7 @@ def uv_sphere(r=1.0, n=16, jitter=0.0, seed=0):
     n = _count("n", n, 2)
     jitter = _jitter(jitter)
     V, F, uv = _uv_ellipsoid_mesh(r, r, r, n, jitter, seed)
-    N = V / r
-    _check_faces(V, F, N, "uv_sphere")
-    params = dict(r=r, n=n, jitter=jitter, seed=seed)
-    truth = _constant_truth(V.shape[0], N, 1.0 / r, 1.0 / r**2)
-    return _make(
-        "sphere",
-        params,
-        V,
-        F,
-        uv,
-        True,
-        truth,
-        area=4.0 * np.pi * r * r,
-        volume=4.0 / 3.0 * np.pi * r**3,
-    )
+    return _sphere_mesh(dict(r=r, n=n, jitter=jitter, seed=seed), V, F, V / r, uv, r, "uv_sphere")
 
 
 # ----------------------------------------------------------------------------
@@ -831,13 +805,7 @@ def torus(R=1.0, r=0.4, n=64, m=None, jitter=0.0, seed=0):
     m = max(3, int(round(n * r / R))) if m is None else _count("m", m, 3)
     jitter = _jitter(jitter)
     du, dv = 2.0 * np.pi / n, 2.0 * np.pi / m
-    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
-    u = (du * i).ravel()
-    v = (dv * j).ravel()
-    if jitter > 0:
-        ou, ov = _grid_jitter(_rng(seed), u.shape, jitter)
-        u = u + du * ou
-        v = v + dv * ov
+    u, v = _jittered_grid(n, np.arange(m), du, dv, jitter, seed)
     V = _torus_point(u, v, R, r)
     F = grid_faces(n, m, periodic_u=True, periodic_v=True)
     # outside: away from the tube's centre circle

@@ -16,8 +16,8 @@ slider on which the value a reader typed is a position.
 
 import numpy as np
 
-from ..mesh.errors import MeshError
-from ..mesh.geometry import mean_edge_length
+from ...mesh.errors import MeshError
+from ...mesh.geometry import mean_edge_length
 
 __all__ = ["STEP_UNITS", "absolute_step", "step_label", "log_slider", "log_positions", "MeshSteps"]
 

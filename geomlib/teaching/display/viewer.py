@@ -12,7 +12,7 @@ is exactly zero; NaN values are drawn bright violet (``colours.NAN_COLOR``, far
 from every colour of the maps for colour-blind readers too) and counted under the
 colour bar, which names the colour.
 
-    from geomlib.teaching.viewer import MeshView, side_by_side
+    from geomlib.teaching.display.viewer import MeshView, side_by_side
     view = MeshView(V, F, values=H, symmetric=True, label="H (1/length)")
     slider = ipywidgets.FloatSlider(0.0, min=0.0, max=1.0, description="t")
     slider.observe(lambda change: view.update(V=V + change["new"] * D), "value")
@@ -35,7 +35,7 @@ if there is none, the first slider displayed by the same cell as a view
 cell change. So a notebook needs at least one slider next to a view in one of
 these two ways, and that slider must change the picture whether it is moved to
 its maximum (or to its minimum when it starts there). Sliders elsewhere are
-not moved by the test (``geomlib.teaching.controls.live`` puts its controls and views in one
+not moved by the test (``geomlib.teaching.display.controls.live`` puts its controls and views in one
 box). Views shown with ``side_by_side`` are also checked for
 linked cameras (an orbit drag in the first view must turn the second).
 
@@ -103,8 +103,9 @@ repository previews still show the mesh. (``jupyter nbconvert --to html``
 shows the still unless the notebook was saved with its widget state; with the
 state it embeds the live widget, which needs the widget scripts from a CDN.)
 A view shown inside an ipywidgets box (``VBox([slider, view.widget])``) is
-drawn too: importing this module in IPython gives every box holding views a
-still picture of them (``box_still``), side by side.
+drawn too: after :func:`setup_display` (each notebook's set-up cell calls it, and
+so does the first view) every box holding views has a still picture of them
+(``box_still``), side by side.
 
 While nbgrader runs a notebook (``autograde``, ``validate``) a view gives its
 still picture and summary only, without the widget (``stills_only``), and other
@@ -117,10 +118,11 @@ import weakref
 
 import numpy as np
 
-from ..mesh.errors import MeshError, format_indices
-from ..mesh.geometry import enclosed_volume
-from ..mesh.topology import Topology, edges
-from ..mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
+from ...mesh.errors import MeshError, format_indices
+from ...mesh.geometry import enclosed_volume
+from ...mesh.topology import Topology, edges
+from ...mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
+from ..notebook import graded
 from .colours import (
     NAN_COLOR,
     NAN_NAME,
@@ -135,7 +137,7 @@ from .colours import (
     value_range,
     zero_html,
 )
-from .notebook import graded
+from .frontends import enable_colab_widgets
 from .stills import (
     FOV,
     UP,
@@ -150,7 +152,7 @@ from .stills import (
     view_normals,
 )
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only"]
+__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only", "setup_display"]
 
 #: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
 #: of the largest one is drawn enlarged to the largest one's size
@@ -285,7 +287,9 @@ class MeshView:
     width, height : int
         Canvas size in pixels.
     title : str or None
-        Heading shown above the canvas.
+        Heading shown above the canvas: what the view shows, a noun ("signed mean
+        curvature", "the mesh coloured by height"); its text alternative begins
+        "3D view of" the title (without one: "3D view of a mesh of n vertices").
     label : str or None
         Name and unit of the values, shown under the colour bar, e.g. "H (1/length)".
     up : {"z", "y", "x"}
@@ -297,6 +301,13 @@ class MeshView:
         Positions whose bounding box frames the camera, e.g. the input mesh when
         V is its smoothed result: a mesh that shrank or collapsed is then drawn
         at the input's scale. Default: V itself.
+    fit : bool
+        Keep the mesh readable whatever an update does to its size: a mesh
+        smaller than ``SPECK_RATIO`` times its frame (a collapse), or one that
+        leaves the frame's bounding sphere (an explosion, a volume kept by a
+        large stretch), is drawn scaled about its own centre to the frame's size,
+        put at the frame's centre, and its title says "drawn N x larger" (or
+        smaller). In between it is drawn as it is, so shrinkage is seen.
     zero_tol : float >= 0
         A field whose finite values all lie within ``zero_tol`` of zero (in the
         values' units) is zero up to rounding: drawn in ``ZERO_COLOR`` (white),
@@ -336,10 +347,12 @@ class MeshView:
         frame=None,
         zero_tol=ZERO_TOL,
         description=None,
+        fit=False,
     ):
         import ipywidgets as widgets
         import pythreejs as three
 
+        setup_display()
         V = as_vertices(V)
         self._n = V.shape[0]
         # a face that repeats a vertex is drawn as nothing, not refused: a view shows any mesh
@@ -363,6 +376,8 @@ class MeshView:
         self.zero_tol = float(zero_tol)
         self._centre, self._radius = bounding_frame(V if frame is None else as_vertices(frame, where="frame"))
         self._scale = 1.0  # drawn this many times larger (side_by_side enlarges specks)
+        self.fit = bool(fit)
+        self._fitted = self._fit_factor(V)  # and this many times larger about its own centre (``fit``)
         self._distance = camera_distance(self._radius, self.width, self.height)
 
         # one interleaved float32 buffer: position (0:3), normal (3:6), colour (6:9)
@@ -485,10 +500,37 @@ class MeshView:
         finite = self._values[np.isfinite(self._values)]
         return bool(finite.size) and float(np.abs(finite).max()) <= self.zero_tol
 
+    def _fit_factor(self, V):
+        """How many times larger V is drawn under ``fit``: 1 while it is at least ``SPECK_RATIO`` of
+        its frame and inside the frame's bounding sphere (which the camera shows whole), else the
+        frame's size over V's."""
+        if not self.fit:
+            return 1.0
+        centre, radius = bounding_frame(V)
+        reach = float(np.linalg.norm(V - self._centre, axis=1).max())
+        if radius < SPECK_RATIO * self._radius or reach > self._radius:
+            return self._radius / radius
+        return 1.0
+
+    def _shown(self):
+        """(n, 3) float64: the positions as drawn (V, or V scaled by ``fit`` about its centre onto the frame's)."""
+        if self._fitted == 1.0:
+            return self._V
+        return self._centre + self._fitted * (self._V - bounding_frame(self._V)[0])
+
+    def _size_note(self):
+        """ "drawn N x larger" (or smaller) when the picture is not to the frame's scale, else ""."""
+        scale = self._scale * self._fitted
+        if scale == 1.0:
+            return ""
+        if scale < 1.0:
+            return f"drawn {1 / scale:.3g} x smaller"
+        return f"drawn {scale:.3g} x larger"
+
     def _title_text(self):
         text = f"<b>{html.escape(self.title)}</b>" if self.title else ""
-        if self._scale != 1.0:
-            text += f" <i>(drawn {self._scale:.3g} x larger)</i>"
+        if self._size_note():
+            text += f" <i>({self._size_note()})</i>"
         return text
 
     def _colors(self):
@@ -507,7 +549,7 @@ class MeshView:
         if V:
             # positions relative to the first bounding-box centre (float32 keeps
             # its precision near the origin)
-            buf[:, 0:3] = self._V - self._centre
+            buf[:, 0:3] = self._shown() - self._centre
             buf[:, 3:6] = view_normals(self._V, self._triangles)
         else:
             buf[:, 0:6] = old[:, 0:6]
@@ -547,10 +589,10 @@ class MeshView:
 
         Shown under the canvas, given to the still as its alt and to the canvas on the website.
         """
-        what = f"3D view of {self.title}" if self.title else "3D view"
-        text = f"{what}: a mesh of {self._n} vertices and {self._F.shape[0]} faces"
-        if self._scale != 1.0:
-            text += f", drawn {self._scale:.3g} times larger"
+        mesh = f"a mesh of {self._n} vertices and {self._F.shape[0]} faces"
+        text = f"3D view of {self.title}: {mesh}" if self.title else f"3D view of {mesh}"
+        if self._size_note():
+            text += f", {self._size_note().replace(' x ', ' times ')}"
         name = self.label or "the values"
         if self._values is None:
             text += ", plain shading (no colour map)."
@@ -599,6 +641,10 @@ class MeshView:
         new_V = V is not None
         if new_V:
             self._V = _check_count(as_vertices(V), self._n)
+            fitted, self._fitted = self._fitted, self._fit_factor(self._V)
+            if fitted != self._fitted:
+                self._title.value = self._title_text()
+                self._title.layout.display = None if self._title.value else "none"
         new_colors = False
         if values is not None:
             self._values = _check_values(values, self._n)
@@ -625,7 +671,7 @@ class MeshView:
         """(h, w, 3) uint8 still picture: the first camera view, title and colour bar."""
         buf = self._buffer.array
         image = render_still(
-            self._V,
+            self._shown(),
             self._F,
             buf[:, 6:9],
             buf[:, 3:6].astype(np.float64),
@@ -636,12 +682,13 @@ class MeshView:
             distance=(distance or self._distance) / self._scale,
             centre=self._centre,
             cull_back=self.closed,
+            edges=None if self.wireframe is None else edges(self._triangles),
         )
         lo, hi = self.range
         lut = self._lut if self._values is not None and not self.is_zero else None
         title = self.title
-        if title and self._scale != 1.0:
-            title = f"{title} (drawn {self._scale:.3g} x larger)"
+        if title and self._size_note():
+            title = f"{title} ({self._size_note()})"
         if self.is_zero:
             title = f"{title or ''}  [{self.label or 'values'}: 0 everywhere]".strip()
         return still_with_colorbar(image, lut, lo, hi, self.label or "", title)
@@ -651,8 +698,8 @@ class MeshView:
         text = f"MeshView: {self._n} vertices, {self._F.shape[0]} faces"
         if self.title:
             text = f"{text} ({self.title})"
-        if self._scale != 1.0:
-            text += f", drawn {self._scale:.3g} x larger"
+        if self._size_note():
+            text += f", {self._size_note()}"
         if self._values is not None and self.is_zero:
             text += f"; {self.label or 'values'}: {self._zero_text()}, drawn white"
         elif self._values is not None:
@@ -764,12 +811,20 @@ def _widget_stills_only(widget):
     )
 
 
-def _give_boxes_stills():
-    """In IPython, display every ipywidgets box with the still of its views as image/png
-    (with ``stills_only``, every widget without its widget view: a box as the still of
-    its views, any other as its text), and draw plots in :func:`.colours.plot_style`."""
+def setup_display():
+    """Set up this session's display for the workbook; each notebook's set-up cell calls it.
+
+    In Colab, enables its custom widget manager (:func:`.frontends.enable_colab_widgets`),
+    without which the 3D views are not drawn. In IPython, displays every ipywidgets box
+    with the still of its views as image/png (with ``stills_only``, every widget without
+    its widget view: a box as the still of its views, any other as its text), and draws
+    plots in :func:`.colours.plot_style`. Calling it again changes nothing; a
+    :class:`MeshView` calls it when it is made, so a view is drawn in a reader's own
+    notebook too.
+    """
     from IPython import get_ipython
 
+    enable_colab_widgets()
     shell = get_ipython()
     if shell is not None:
         import ipywidgets
@@ -779,9 +834,6 @@ def _give_boxes_stills():
             shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_stills_only)
         # a notebook's own plots: colour-blind-safe colours, each with its own line style
         use_plot_style()
-
-
-_give_boxes_stills()
 
 
 def side_by_side(*views, link_cameras=True):

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .errors import MeshError, format_indices
+from ..mesh.errors import MeshError, format_indices
 
 __all__ = ["positive_vertex_areas"]
 
