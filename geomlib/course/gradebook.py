@@ -6,7 +6,10 @@ course's gradebook right after, through nbgrader's own API (:func:`copy_submissi
 so the course's gradebook ends with the rows a serial ``nbgrader autograde`` writes.
 """
 
+import warnings
+
 from sqlalchemy import inspect as sa_inspect
+from sqlalchemy.exc import SAWarning
 
 
 def _copy_columns(source, target):
@@ -26,6 +29,13 @@ def copy_submission(source, target, assignment, student):
     grade) and each comment. The assignment must already be in ``target`` (as
     ``generate_assignment`` puts it there); a submission already there is overwritten,
     as autograde overwrites it."""
+    with warnings.catch_warnings():
+        # nbgrader's add_submission builds rows SQLAlchemy warns about (autograde's own log has them too)
+        warnings.simplefilter("ignore", SAWarning)
+        _copy(source, target, assignment, student)
+
+
+def _copy(source, target, assignment, student):
     student_row = source.find_student(student)
     target.update_or_create_student(
         student, **{k: v for k, v in student_row.to_dict().items() if k not in ("id", "score", "max_score")}
