@@ -331,13 +331,16 @@ def renamed_solution(body):
 
 
 def geomlib_copy():
-    """geomlib's uniform_laplacian pasted into the answer, its docstring dropped and its helpers imported."""
+    """geomlib's uniform Laplacian pasted into the answer: the body of the routine that does the
+    work, its docstring dropped and geomlib's edge table (which the ground rules refuse) rebuilt."""
     from geomlib.lessons import laplace
 
-    source = inspect.getsource(laplace.uniform_laplacian)
+    source = inspect.getsource(laplace.graph_laplacian)
     body = textwrap.dedent(source.split('"""')[2].split("\n", 1)[1])
-    imports = "from geomlib.mesh.topology import edges\nfrom geomlib.mesh.validate import as_mesh\n"
-    return imports + body.replace("sp.", "sparse.")
+    body = body.replace(
+        "edges(F)", "np.unique(np.sort(np.r_[F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]], axis=1), axis=0)"
+    )
+    return "n = len(V)\n" + body.replace("sp.", "sparse.")
 
 
 SOLUTION = "solution"  # stands for the solution notebook's answer, verbatim

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import nbformat
 
 from .coursedir import load_course
-from .similarity import geomlib_source, similar_answers
+from .similarity import COPIED, NEAR_IDENTICAL, geomlib_source, similar_answers
 
 #: the outcomes of an auto-graded exercise, in the order the report shows them
 KINDS = ("passed", "named mistake", "catch-all", "refused", "not written", "not submitted")
@@ -317,7 +317,8 @@ def render_html(results, rows, flags, picture):
         parts.append("<p>None: no answer shares most of its code with another student's or with the solution.</p>")
     parts.append(
         "<p><small>A flag is a reason to look, not a verdict: read the two answers side by side. "
-        "Near-identical means copydetect finds at least 90% of each answer's tokenised code in the other "
+        f"Near-identical means copydetect finds at least {NEAR_IDENTICAL:.0%} of each answer's tokenised code "
+        f"in the other; a copy, at least {COPIED:.0%} of the answer's in the solution notebook's or geomlib's "
         "(names, comments and spacing ignored).</small></p></body></html>"
     )
     return "\n".join(parts)

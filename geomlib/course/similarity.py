@@ -9,8 +9,8 @@ boilerplate: what every student was handed matches nobody. A student who left th
 is compared with no one.
 
 A pair is flagged when each of the two answers is at least :data:`NEAR_IDENTICAL` covered by
-the other; a copy when the answer is that much covered by a reference (geomlib's routine
-carries a docstring and checks the student's copy leaves out).
+the other; a copy when the answer is at least :data:`COPIED` covered by a reference (however
+much of the reference it takes: geomlib's routine carries checks a copy leaves out).
 """
 
 import ast
@@ -21,8 +21,12 @@ import tempfile
 import textwrap
 from pathlib import Path
 
-#: share of each file's tokens found in the other above which two answers are flagged
+#: share of each answer's tokens found in the other above which two students' answers are flagged
 NEAR_IDENTICAL = 0.9
+#: share of an answer's tokens found in a reference above which it is flagged as a copy of it
+#: (lower: a copier rewrites the helpers the ground rules refuse, such as geomlib's edge table;
+#: honest answers share at most about a fifth of their code with a reference)
+COPIED = 0.5
 #: copydetect's noise threshold (characters of tokenised code): matches shorter than this are ignored
 NOISE = 30
 
@@ -41,16 +45,27 @@ def _without_docstrings(source):
     return "\n".join(line for k, line in enumerate(source.splitlines(), 1) if k not in drop)
 
 
+def _called_geomlib_functions(fn):
+    """The geomlib functions ``fn`` calls by a plain name (its helpers that do the work)."""
+    found = []
+    for node in ast.walk(ast.parse(textwrap.dedent(inspect.getsource(fn)))):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+            target = getattr(inspect.getmodule(fn), node.func.id, None)
+            if inspect.isfunction(target) and target.__module__.startswith("geomlib.") and target not in found:
+                found.append(target)
+    return found
+
+
 def geomlib_source(check_fn):
-    """The code of geomlib's own routines of an exercise (``check.NAME.own``), docstrings left
-    out, joined; "" if none."""
+    """The code of geomlib's own routines of an exercise (``check.NAME.own``) and of the geomlib
+    functions they call (a thin routine hands its work to one), docstrings left out; "" if none."""
     parts = []
     for dotted in getattr(check_fn, "own", ()):
         module, _, name = dotted.rpartition(".")
         try:
-            parts.append(
-                _without_docstrings(inspect.getsource(getattr(importlib.import_module(f"geomlib.{module}"), name)))
-            )
+            fn = getattr(importlib.import_module(f"geomlib.{module}"), name)
+            for f in [fn, *_called_geomlib_functions(fn)]:
+                parts.append(_without_docstrings(inspect.getsource(f)))
         except (ImportError, AttributeError, OSError, TypeError):
             continue
     return "\n\n".join(parts)
@@ -117,7 +132,7 @@ def similar_answers(answers, references, stub):
                 # a copy of a reference: the student's code is the reference's (however much of the
                 # reference's file it takes); a pair: each of the two is the other's
                 share = float(mine if kind == "reference" else min(mine, theirs))
-                if test == ref or share < NEAR_IDENTICAL:
+                if test == ref or share < (COPIED if kind == "reference" else NEAR_IDENTICAL):
                     continue
                 if kind == "reference":
                     flags.append((student, f"copy of {other}", f"{share:.0%} of the code shared"))
