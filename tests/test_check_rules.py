@@ -17,13 +17,13 @@ import geomlib.lessons.spectral as spectral
 import geomlib.lessons.symbolic as symbolic
 import geomlib.numerics.eigen as eigen
 from geomlib import check
+from geomlib.lessons.laplace import intrinsic_cotangent_matrix
 from geomlib.teaching.check.result import reveal
 
 SHORTCUTS = {
     "uniform_laplacian": lambda V, F: geomlib.laplacian(V, F, weights="uniform"),
     "gaussian_curvature": lambda V, F: geomlib.gaussian_curvature(V, F),
-    "cotangent_laplacian": lambda V, F: geomlib.laplacian(V, F),
-    "vertex_areas": lambda V, F: geomlib.vertex_areas(V, F),
+    "cotangent_matrix": lambda l, F: intrinsic_cotangent_matrix(l, F),
     "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
     "spectral_reconstruction": lambda V, F, k: geomlib.spectral_reconstruction(V, F, k, cache=False),
     "eigenpairs": lambda M, C, k: spectral.eigenpairs(M, C, k),
@@ -37,6 +37,7 @@ SHORTCUTS = {
     "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
         V, F, sigma, tau, iterations, seed
     )[0],
+    "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
     "normal_curvature": lambda forms, a, b, c, u, v, phi: symbolic.forms_normal_curvature(forms, a, b, c, u, v, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
 }
