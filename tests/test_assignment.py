@@ -147,7 +147,7 @@ def test_the_leak_finder_sees_a_shown_routine(tmp_path):
     nb = nbformat.v4.new_notebook()
     body = sorted(forbidden_lines("lessons.smoothing.explicit_step"))[0]
     nb.cells = [nbformat.v4.new_code_cell(f"x = 1\n{body}\n")]
-    assert [(e, n) for e, n, _ in answer_leaks(nb, ["explicit_step"])] == [("explicit_step", "explicit_step")]
+    assert ("smoothing_loop", "explicit_step") in [(e, n) for e, n, _ in answer_leaks(nb, ["smoothing_loop"])]
 
 
 @pytest.mark.slow

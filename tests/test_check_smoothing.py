@@ -1,23 +1,19 @@
-"""The exercise checks of notebooks 05 and 06: each accepts the reference
-solution and its legitimate variants (an iterative solver at its default
-tolerance, dense matrices, any way of holding a boundary), names every typical
-wrong implementation of the catalogue (written here with numpy and scipy) by its
-mistake, and reports an unwritten stub as "not written yet"."""
-
-import time
+"""The exercise checks of notebooks 05 and 06: each accepts the reference solution and its
+legitimate variants (power iteration or Lanczos; any way of holding the boundary; splu, a
+dense solve or cg at its default tolerance, factorised once or every step), names every
+entry of its catalogue of typical mistakes when a learner's code (written here with numpy
+and scipy) makes it, refuses the shortcuts its ground rules exclude, and reports an
+unwritten stub as "not written yet"."""
 
 import numpy as np
 import pytest
 import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
-from diagnoses import assert_diagnosed
 
-from geomlib import check, laplacian
-from geomlib import explicit_step_limit as reference_limit_of_mesh
-from geomlib.lessons.smoothing import explicit_step, implicit_step
-from geomlib.mesh.topology import boundary_vertices
-from geomlib.teaching.check import CheckFailed
+from geomlib import boundary_vertices, check, laplacian
+from geomlib.teaching.check.explicit import LAM_MAX_MISTAKES, LOOP_MISTAKES
+from geomlib.teaching.check.implicit import IMPLICIT_MISTAKES
 
 
 @pytest.fixture(autouse=True)
@@ -26,370 +22,259 @@ def lenient(monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
 
 
-def areas(M):
-    return M.diagonal()[:, None]
+# --------------------------------------------------------------------------- lambda_max
 
 
-def reference_limit(M, C):
-    return 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[-1]
+def power(M, C, sign=1.0, exponent=-0.5, iterations=20_000, rtol=1e-12, limit=False, smallest=False):
+    """A learner's power iteration on Q = -M^e C M^e, with the named changes."""
+    d = M.diagonal() ** exponent
+    Q = sp.diags(d) @ (-sign * C) @ sp.diags(d)
+    if smallest:
+        return float(sla.eigsh(Q, 1, which="SA")[0][0])
+    z = np.random.default_rng(1).standard_normal(Q.shape[0])
+    lam = 0.0
+    for _ in range(iterations):
+        Qz = Q @ z
+        lam, previous = z @ Qz / (z @ z), lam
+        z = Qz / np.linalg.norm(Qz)
+        if abs(lam - previous) <= rtol * abs(lam):
+            break
+    return 2 / lam if limit else lam
 
 
-def solve(A, B):
-    return sla.spsolve(sp.csc_matrix(A), B)
+def lanczos(M, C):
+    d = 1 / np.sqrt(M.diagonal())
+    Q = sla.LinearOperator(C.shape, matvec=lambda z: -d * (C @ (d * z)), dtype=float)
+    return sla.eigsh(Q, 1, which="LA")[0][0]
 
 
-STEP_MISTAKES = {
-    "sign": (lambda P, M, C, tau: P - tau * (C @ P) / areas(M), "sign is flipped"),
-    "C for M^-1 C": (lambda P, M, C, tau: P + tau * (C @ P), "C was used where M^-1 C belongs"),
-    "displacement": (lambda P, M, C, tau: tau * (C @ P) / areas(M), "returns the displacement"),
-    "times M": (lambda P, M, C, tau: P + tau * areas(M) * (C @ P), "multiplied by M instead of divided"),
-    "no tau": (lambda P, M, C, tau: P + (C @ P) / areas(M), "the step tau is missing"),
-    "C M^-1": (lambda P, M, C, tau: P + tau * (C @ (P / areas(M))), "C M^-1 P"),
-    "one coordinate": (lambda P, M, C, tau: (P + tau * (C @ P) / areas(M))[:, 0], "expected ("),
-    "something else": (lambda P, M, C, tau: P + 0.5 * tau * (C @ P) / areas(M), "differ from P + tau M^-1 C P"),
-    # the uniform step (neighbour averaging) written for the cotangent C it was handed
-    "divided by |C_ii|": (lambda P, M, C, tau: P + tau * (C @ P) / -C.diagonal()[:, None], "divides C P by |C_ii|"),
-    "neighbour average": (
-        lambda P, M, C, tau: P + tau * (neighbours(C) @ P / neighbours(C).sum(axis=1).A - P),
-        "the uniform step (every neighbour weighs 1",
-    ),
-    "C P over the valence": (
-        lambda P, M, C, tau: P + tau * (C @ P) / neighbours(C).sum(axis=1).A,
-        "the uniform step (every neighbour weighs 1",
-    ),
+def gershgorin(M, C):
+    return np.max(np.asarray(abs(C).sum(axis=1)).ravel() / M.diagonal())
+
+
+LAM_MAX_LEARNERS = {
+    "the step limit 2 / lam_max": lambda M, C: power(M, C, limit=True),
+    "the smallest eigenvalue was found": lambda M, C: power(M, C, smallest=True),
+    "the sign of C is flipped": lambda M, C: power(M, C, sign=-1.0),
+    "M is left out": lambda M, C: power(M, C, exponent=0.0),
+    "M^-1 stands on both sides": lambda M, C: power(M, C, exponent=-1.0),
+    "M multiplies instead of dividing": lambda M, C: power(M, C, exponent=0.5),
+    "Gershgorin's bound": gershgorin,
+    "stopped too early": lambda M, C: power(M, C, iterations=3),
+    "differs from the largest eigenvalue": lambda M, C: 1.3 * power(M, C),
 }
 
 
-def neighbours(C):
-    """The adjacency of C's graph, every weight 1 (what a uniform step averages over)."""
-    A = sp.csr_matrix(C, copy=True)
-    A.setdiag(0)
-    A.eliminate_zeros()
-    A.data[:] = 1.0
-    return A
+def test_power_iteration_and_lanczos_pass():
+    assert check.lam_max.evaluate(power).passed
+    assert check.lam_max.evaluate(lanczos).passed
 
 
-@pytest.mark.parametrize("name", STEP_MISTAKES)
-def test_a_step_mistake_the_check_names_earns_partial_credit(name):
-    wrong, _ = STEP_MISTAKES[name]
-    earned = check.explicit_step.partial_credit(wrong).passed
-    assert earned == (name not in ("one coordinate", "something else")), check.explicit_step(wrong).message
+@pytest.mark.parametrize("name", LAM_MAX_LEARNERS)
+def test_each_lam_max_mistake_is_named(name):
+    result = check.lam_max.evaluate(LAM_MAX_LEARNERS[name])
+    assert not result.passed and name in result.message, result.message
+    assert result.partial == (name != "differs from the largest eigenvalue")
 
 
-def on_matrices(wrong):
-    """A learner's fn(V, F) that builds (M, C) and then makes the mistake ``wrong(M, C)``."""
-    return lambda V, F: wrong(*laplacian(V, F))
+def test_a_dense_or_generalised_solver_is_refused():
+    dense = lambda M, C: np.linalg.eigvalsh(-C.toarray() / np.sqrt(np.outer(M.diagonal(), M.diagonal())))[-1]  # noqa: E731
+    generalised = lambda M, C: scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[-1]  # noqa: E731
+    for fn, name in ((dense, "numpy.linalg.eigvalsh"), (generalised, "scipy.linalg.eigh")):
+        result = check.lam_max.evaluate(fn)
+        assert not result.partial and f"calls {name}" in result.message, result.message
 
 
-LIMIT_MISTAKES = {
-    "1/lam_max": (lambda M, C: reference_limit(M, C) / 2, "1 / lam_max, half the true one"),
-    "eigenvalues of C": (lambda M, C: 2 / np.linalg.eigvalsh(-C.toarray())[-1], "from C instead of M^-1 C"),
-    "smallest non-zero": (
-        lambda M, C: 2 / scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[1],
-        "smallest non-zero eigenvalue",
-    ),
-    "smallest, zero": (
-        lambda M, C: 2 / abs(scipy.linalg.eigh(-C.toarray(), M.toarray(), eigvals_only=True)[0]),
-        "smallest eigenvalue (0, the constant mode)",
-    ),
-    "sign": (lambda M, C: -reference_limit(M, C), "negative limit"),
-    "lam_max itself": (lambda M, C: 2 / reference_limit(M, C), "returns lam_max"),
-    "a vector": (lambda M, C: np.full(3, reference_limit(M, C)), "not one number"),
+# --------------------------------------------------------------------------- the loops
+
+
+def split(V, F):
+    B = boundary_vertices(F, len(V))
+    return np.setdiff1d(np.arange(len(V)), B), B
+
+
+def explicit(
+    V,
+    F,
+    tau,
+    N,
+    held=True,
+    rebuild=False,
+    weights="cotan",
+    coupled=True,
+    refuse=True,
+    in_place=False,
+    extra=0,
+    scale=1.0,
+    same_V=False,
+):
+    """A learner's explicit loop with the named changes."""
+    I, B = split(V, F) if held else (np.arange(len(V)), [])
+    M, C = laplacian(V, F, weights=weights)
+    m_I, C_I = M.diagonal()[I], C.tocsr()[I]
+    d = 1 / np.sqrt(m_I)
+    if refuse and tau >= 2 / np.linalg.eigvalsh(-(d[:, None] * C_I[:, I].toarray() * d))[-1]:
+        raise ValueError("past the limit")
+    P = V if in_place else V.copy()
+    for _ in range(N + extra):
+        if rebuild:
+            M, C = laplacian(P, F, weights=weights)
+            m_I, C_I = M.diagonal()[I], C.tocsr()[I]
+        step = (C_I @ P) if coupled else C_I[:, I] @ P[I]
+        P[I] += scale * tau * step / m_I[:, None]
+    return V.copy() if same_V else P
+
+
+def explicit_areas(a):
+    """The loop with C P multiplied by M^a (a = 0: M forgotten, a = 1: multiplied)."""
+
+    def learner(V, F, tau, N):
+        I, _ = split(V, F)
+        M, C = laplacian(V, F)
+        P = V.copy()
+        for _ in range(N):
+            P[I] += tau * (M.diagonal()[I] ** a)[:, None] * (C.tocsr()[I] @ P)
+        return P
+
+    return learner
+
+
+LOOP_LEARNERS = {
+    "no step was taken": lambda V, F, tau, N: explicit(V, F, tau, N, same_V=True),
+    "one step too few": lambda V, F, tau, N: explicit(V, F, tau, N, extra=-1),
+    "one step too many": lambda V, F, tau, N: explicit(V, F, tau, N, extra=1),
+    "the boundary moves": lambda V, F, tau, N: explicit(V, F, tau, N, held=False),
+    "rebuilt from the moving mesh": lambda V, F, tau, N: explicit(V, F, tau, N, rebuild=True),
+    "sign of the step is flipped": lambda V, F, tau, N: explicit(V, F, tau, N, scale=-1.0),
+    "half a step": lambda V, F, tau, N: explicit(V, F, tau, N, scale=0.5),
+    "M is forgotten": explicit_areas(0.0),
+    "multiplied by the vertex areas": explicit_areas(1.0),
+    "uniform operator": lambda V, F, tau, N: explicit(V, F, tau, N, weights="uniform", refuse=False),
+    "pull C_IB P_B is left out": lambda V, F, tau, N: explicit(V, F, tau, N, coupled=False),
+    "changed its input V in place": lambda V, F, tau, N: explicit(V, F, tau, N, in_place=True),
+    "ran instead of being refused": lambda V, F, tau, N: explicit(V, F, tau, N, refuse=False),
 }
 
-IMPLICIT_MISTAKES = {
-    "M + tau C": (lambda P, M, C, tau: solve(M + tau * C, M @ P), "(M + tau C) instead of (M - tau C)"),
-    "rhs P": (lambda P, M, C, tau: solve(M - tau * C, P), "right-hand side is P instead of M P"),
-    "I - tau C": (lambda P, M, C, tau: solve(sp.identity(len(P)) - tau * C, P), "(I - tau C): M is missing"),
-    "explicit": (lambda P, M, C, tau: P + tau * (C @ P) / areas(M), "one explicit step"),
-    "displacement": (lambda P, M, C, tau: solve(M - tau * C, M @ P) - P, "returns the displacement"),
-    "transposed": (lambda P, M, C, tau: solve(M - tau * C, M @ P).T, "expected ("),
+
+def test_the_loop_and_its_variants_pass():
+    assert check.smoothing_loop.evaluate(explicit).passed
+
+    def put_back(V, F, tau, N):  # every vertex steps, the boundary put back after each step: fine
+        I, B = split(V, F)
+        M, C = laplacian(V, F)
+        d = 1 / np.sqrt(M.diagonal()[I])
+        if tau >= 2 / np.linalg.eigvalsh(-(d[:, None] * C.toarray()[np.ix_(I, I)] * d))[-1]:
+            raise ValueError("past the limit")
+        P = V.copy()
+        for _ in range(N):
+            P = P + tau * (C @ P) / M.diagonal()[:, None]
+            P[B] = V[B]
+        return P
+
+    assert check.smoothing_loop.evaluate(put_back).passed
+
+
+@pytest.mark.parametrize("name", LOOP_LEARNERS)
+def test_each_loop_mistake_is_named(name):
+    result = check.smoothing_loop.evaluate(LOOP_LEARNERS[name])
+    assert not result.passed and result.partial and name in result.message, result.message
+
+
+def implicit(
+    V,
+    F,
+    tau,
+    N,
+    held=True,
+    rebuild=False,
+    sign=1.0,
+    mass=True,
+    rhs_mass=True,
+    coupling=1.0,
+    weights="cotan",
+    solver="splu",
+    extra=0,
+    scale=1.0,
+    every_step=False,
+    same_V=False,
+    in_place=False,
+):
+    """A learner's implicit loop with the named changes."""
+    I, B = split(V, F) if held else (np.arange(len(V)), np.arange(0))
+    tau = scale * tau
+    P = V if in_place else V.copy()
+    for k in range(N + extra):
+        if k == 0 or rebuild or every_step:
+            M, C = laplacian(P if rebuild else V, F, weights=weights)
+            m, C_I = M.diagonal()[I], C.tocsr()[I]
+            A = (sp.diags(m if mass else np.ones(len(I))) - sign * tau * C_I[:, I]).tocsc()
+            if solver == "splu":
+                solve = sla.splu(A).solve
+            elif solver == "dense":
+                solve = lambda R, A=A.toarray(): np.linalg.solve(A, R)  # noqa: E731
+            else:
+                solve = lambda R, A=A: np.column_stack([sla.cg(A, R[:, j])[0] for j in range(3)])  # noqa: E731
+        P[I] = solve((m[:, None] if rhs_mass else 1.0) * P[I] + coupling * sign * tau * (C_I[:, B] @ P[B]))
+    return V.copy() if same_V else P
+
+
+IMPLICIT_LEARNERS = {
+    "no step was taken": lambda V, F, tau, N: implicit(V, F, tau, N, same_V=True),
+    "one step too few": lambda V, F, tau, N: implicit(V, F, tau, N, extra=-1),
+    "one step too many": lambda V, F, tau, N: implicit(V, F, tau, N, extra=1),
+    "the boundary moves": lambda V, F, tau, N: implicit(V, F, tau, N, held=False),
+    "rebuilt from the moving mesh": lambda V, F, tau, N: implicit(V, F, tau, N, rebuild=True),
+    "sign of tau C is flipped": lambda V, F, tau, N: implicit(V, F, tau, N, sign=-1.0),
+    "half a step": lambda V, F, tau, N: implicit(V, F, tau, N, scale=0.5),
+    "M is forgotten in the matrix: (I - tau C_II)": lambda V, F, tau, N: implicit(V, F, tau, N, mass=False),
+    "forgotten in the matrix and on the right": lambda V, F, tau, N: implicit(V, F, tau, N, mass=False, rhs_mass=False),
+    "holds P_I where M_II P_I belongs": lambda V, F, tau, N: implicit(V, F, tau, N, rhs_mass=False),
+    "term tau C_IB P_B is missing": lambda V, F, tau, N: implicit(V, F, tau, N, coupling=0.0),
+    "term has the wrong sign": lambda V, F, tau, N: implicit(V, F, tau, N, coupling=-1.0),
+    "these are explicit steps": lambda V, F, tau, N: explicit(V, F, tau, N, refuse=False),
+    "uniform operator": lambda V, F, tau, N: implicit(V, F, tau, N, weights="uniform"),
+    "changed its input V in place": lambda V, F, tau, N: implicit(V, F, tau, N, in_place=True),
 }
 
 
-def step(P, M, C, tau):
-    return P + tau * (C @ P) / areas(M)
+@pytest.mark.parametrize("solver", ["splu", "dense", "cg"])
+@pytest.mark.parametrize("every_step", [False, True])
+def test_the_implicit_loop_passes_with_any_fair_solver(solver, every_step):
+    learner = lambda V, F, tau, N: implicit(V, F, tau, N, solver=solver, every_step=every_step)  # noqa: E731
+    result = check.implicit_loop.evaluate(learner)
+    assert result.passed, result.message
 
 
-def implicit(P, M, C, tau):
-    return solve(M - tau * C, M @ P)
-
-
-def test_references_pass_quickly():
-    for name, fn in (
-        ("explicit_step", step),
-        ("explicit_step_limit", on_matrices(reference_limit)),
-        ("implicit_step", implicit),
-        ("smoothing_loop", masked_rows),
-    ):
-        start = time.perf_counter()
-        result = getattr(check, name)(fn)
-        assert result.passed, result.message
-        assert "ellipsoid" in result.message
-        assert time.perf_counter() - start < 1.0
+@pytest.mark.parametrize("name", IMPLICIT_LEARNERS)
+def test_each_implicit_mistake_is_named(name):
+    result = check.implicit_loop.evaluate(IMPLICIT_LEARNERS[name])
+    assert not result.passed and result.partial and name in result.message, result.message
 
 
 @pytest.mark.parametrize(
-    "name, fn",
-    [
-        ("explicit_step", explicit_step),
-        ("explicit_step_limit", reference_limit_of_mesh),
-        ("implicit_step", implicit_step),
-    ],
+    "catalogue, learners",
+    [(LAM_MAX_MISTAKES, LAM_MAX_LEARNERS), (LOOP_MISTAKES, LOOP_LEARNERS), (IMPLICIT_MISTAKES, IMPLICIT_LEARNERS)],
 )
-def test_geomlibs_own_routine_is_refused(name, fn):
-    assert_diagnosed(getattr(check, name)(fn), "earns no points")
+def test_every_named_mistake_of_a_catalogue_has_a_learner_here(catalogue, learners):
+    for entry in catalogue:
+        if entry.when is None and entry.build is None:
+            continue
+        if "boundary vertices moved" in entry.diagnosis:  # the general form of the named ways a boundary moves
+            continue
+        assert any(name in entry.diagnosis for name in learners), entry.diagnosis
 
 
-def by_columns(solver, **options):
-    """An implicit step solved column by column with an iterative ``solver`` of scipy at its defaults."""
-
-    def fn(P, M, C, tau):
-        A, R = sp.csr_matrix(M - tau * C), M @ P
-        return np.column_stack([solver(A, R[:, j], **options)[0] for j in range(R.shape[1])])
-
-    return fn
-
-
-IMPLICIT_VARIANTS = {
-    "cg, default tolerance": by_columns(sla.cg),
-    "minres, default tolerance": by_columns(sla.minres),
-    "bicgstab, default tolerance": by_columns(sla.bicgstab),
-    "dense solve": lambda P, M, C, tau: np.linalg.solve((M - tau * C).toarray(), M @ P),
-    "splu": lambda P, M, C, tau: sla.splu(sp.csc_matrix(M - tau * C)).solve(M @ P),
-}
-
-
-@pytest.mark.parametrize("name", IMPLICIT_VARIANTS)
-def test_a_right_implicit_step_passes_whatever_its_solver(name):
-    result = check.implicit_step(IMPLICIT_VARIANTS[name])
-    assert result.passed, result.message
-
-
-def test_a_mistake_solved_by_cg_is_still_named():
-    def rhs_p_by_cg(P, M, C, tau):
-        A = sp.csr_matrix(M - tau * C)
-        return np.column_stack([sla.cg(A, P[:, j])[0] for j in range(3)])
-
-    assert_diagnosed(check.implicit_step(rhs_p_by_cg), "right-hand side is P instead of M P")
-
-
-def test_the_equivalent_implicit_form_passes():
-    def with_delta(P, M, C, tau):  # (I - tau M^-1 C) P' = P is the same system divided by M
-        return solve(sp.identity(len(P)) - tau * sp.diags(1 / M.diagonal()) @ C, P)
-
-    assert check.implicit_step(with_delta).passed
-
-
-@pytest.mark.parametrize("name", STEP_MISTAKES)
-def test_explicit_step_mistakes(name):
-    fn, phrase = STEP_MISTAKES[name]
-    assert_diagnosed(check.explicit_step(fn), phrase, "Reread section 1 · The heat flow, one explicit step at a time")
-
-
-@pytest.mark.parametrize("name", LIMIT_MISTAKES)
-def test_explicit_step_limit_mistakes(name):
-    wrong, phrase = LIMIT_MISTAKES[name]
-    assert_diagnosed(
-        check.explicit_step_limit(on_matrices(wrong)), phrase, "Reread section 2 · Why the step has a limit"
-    )
-
-
-@pytest.mark.parametrize("name", IMPLICIT_MISTAKES)
-def test_implicit_step_mistakes(name):
-    fn, phrase = IMPLICIT_MISTAKES[name]
-    assert_diagnosed(check.implicit_step(fn), phrase, "Reread section 1 · Backward Euler, derived")
-
-
-@pytest.mark.parametrize("name", ["explicit_step", "explicit_step_limit", "implicit_step", "smoothing_loop"])
-def test_stubs_are_not_written_yet(name, monkeypatch):
+@pytest.mark.parametrize("name", ["lam_max", "smoothing_loop", "implicit_loop"])
+def test_a_stub_is_not_written_yet(name):
     def stub(*args):
-        raise NotImplementedError("Your turn")
+        raise NotImplementedError
 
-    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")  # a stub never raises, even under the tests
-    assert_diagnosed(getattr(check, name)(stub), "not written yet")
-
-
-def test_a_wrong_answer_raises_under_the_strict_tests(monkeypatch):
-    monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
-    with pytest.raises(CheckFailed, match="sign is flipped"):
-        check.explicit_step(STEP_MISTAKES["sign"][0])
+    result = getattr(check, name).evaluate(stub)
+    assert not result.passed and not result.written and "not written yet" in result.message
 
 
-def test_a_crashing_function_is_named():
-    assert_diagnosed(check.implicit_step(lambda P, M, C, tau: P @ M), "raised ValueError")
-
-
-# --------------------------------------------------------------------------
-# the smoothing loop with the boundary held (notebook 05, section 4)
-
-
-def held(F, n):
-    mask = np.zeros(n, dtype=bool)
-    mask[boundary_vertices(F, n)] = True
-    return mask
-
-
-def masked_rows(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    moving, P = ~held(F, len(V)), V.copy()
-    for _ in range(iterations):
-        P = P + tau * moving[:, None] * (C @ P) / areas(M)
-    return P
-
-
-def reset_positions(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    B, P = held(F, len(V)), V.copy()
-    for _ in range(iterations):
-        P = P + tau * (C @ P) / areas(M)
-        P[B] = V[B]
-    return P
-
-
-def reduced_system(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    B = held(F, len(V))
-    C = C.tocsr()
-    C_II, C_IB, m_I = C[~B][:, ~B], C[~B][:, B], M.diagonal()[~B][:, None]
-    P = V.copy()
-    for _ in range(iterations):
-        P[~B] = P[~B] + tau * (C_II @ P[~B] + C_IB @ V[B]) / m_I
-    return P
-
-
-def dense_matrix_power(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    S = C.toarray() / M.diagonal()[:, None]
-    S[held(F, len(V))] = 0.0
-    return np.linalg.matrix_power(np.eye(len(V)) + tau * S, iterations) @ V
-
-
-def every_vertex(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    P = V.copy()
-    for _ in range(iterations):
-        P = P + tau * (C @ P) / areas(M)
-    return P
-
-
-def rebuilt_each_step(V, F, tau, iterations):
-    moving, P = ~held(F, len(V)), V.copy()
-    for _ in range(iterations):
-        M, C = laplacian(P, F)
-        P = P + tau * moving[:, None] * (C @ P) / areas(M)
-    return P
-
-
-def rebuilt_and_free(V, F, tau, iterations):
-    P = V.copy()
-    for _ in range(iterations):
-        M, C = laplacian(P, F)
-        P = P + tau * (C @ P) / areas(M)
-    return P
-
-
-def uniform_weights(V, F, tau, iterations):
-    M, C = laplacian(V, F, weights="uniform")
-    moving, P = ~held(F, len(V)), V.copy()
-    for _ in range(iterations):
-        P = P + tau * moving[:, None] * (C @ P) / areas(M)
-    return P
-
-
-def half_held(V, F, tau, iterations):
-    P, Q = masked_rows(V, F, tau, iterations), every_vertex(V, F, tau, iterations)
-    B = held(F, len(V))
-    P[B] = (P[B] + Q[B]) / 2
-    return P
-
-
-LOOP_VARIANTS = {
-    "rows masked": masked_rows,
-    "positions reset": reset_positions,
-    "reduced system": reduced_system,
-    "dense matrix power": dense_matrix_power,
-}
-
-LOOP_MISTAKES = {
-    "the boundary moves": (every_vertex, "the boundary moves: every vertex was updated"),
-    "operator rebuilt": (rebuilt_each_step, "M and C are rebuilt from the moving mesh at every step"),
-    "rebuilt and free": (rebuilt_and_free, "smoothing asked for); the boundary moves: every vertex"),
-    "N - 1 steps": (lambda V, F, tau, n: masked_rows(V, F, tau, n - 1), "3 steps for iterations = 4 (one too few)"),
-    "N + 1 steps": (lambda V, F, tau, n: masked_rows(V, F, tau, n + 1), "5 steps for iterations = 4 (one too many)"),
-    "uniform weights": (uniform_weights, "smooths with the uniform operator"),
-    "sign": (lambda V, F, tau, n: masked_rows(V, F, -tau, n), "sign of the step is flipped"),
-    "no areas": (lambda V, F, tau, n: no_areas(V, F, tau, n), "not divided by the vertex areas"),
-    "boundary half held": (half_held, "the boundary vertices moved (the furthest by"),
-    "something else": (lambda V, F, tau, n: masked_rows(V, F, 0.7 * tau, n), "differ from the loop"),
-    "the input": (lambda V, F, tau, n: V.copy(), "returns the input positions unchanged"),
-}
-
-
-def no_areas(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    moving, P = ~held(F, len(V)), V.copy()
-    for _ in range(iterations):
-        P = P + tau * moving[:, None] * (C @ P)
-    return P
-
-
-@pytest.mark.parametrize("name", LOOP_VARIANTS)
-def test_any_way_of_holding_the_boundary_passes(name):
-    result = check.smoothing_loop(LOOP_VARIANTS[name])
-    assert result.passed, result.message
-    assert "open noisy grid" in result.message and "closed ellipsoid" in result.message
-
-
-@pytest.mark.parametrize("name", LOOP_MISTAKES)
-def test_smoothing_loop_mistakes(name):
-    fn, phrase = LOOP_MISTAKES[name]
-    result = check.smoothing_loop(fn)
-    assert_diagnosed(result, phrase, "Reread section 3 · The smoothing loop, boundary held")
-    assert check.smoothing_loop.partial_credit(fn).passed == (name != "something else"), result.message
-
-
-def test_the_loop_may_not_hand_the_work_to_geomlibs_smoothers():
-    from geomlib import ExplicitSmoother, ImplicitSmoother, implicit_smoothing
-    from geomlib.lessons.operator import LaplaceOperator
-
-    for fn, named in (
-        (lambda V, F, tau, n: ExplicitSmoother(V, F).smooth(tau, n), "ExplicitSmoother"),
-        (lambda V, F, tau, n: implicit_smoothing(V, F, tau, n), "implicit_smoothing"),
-        (lambda V, F, tau, n: ImplicitSmoother(V, F).smooth(tau, n), "ImplicitSmoother"),
-        (lambda V, F, tau, n: LaplaceOperator(V, F).M_step @ V, "LaplaceOperator"),
-    ):
-        assert_diagnosed(check.smoothing_loop(fn), f"`{named}`", "earns no points")
-
-
-def zeroed_boundary_areas(V, F, tau, iterations):
-    M, C = laplacian(V, F)
-    moving, P = ~held(F, len(V)), V.copy()
-    m = M.diagonal().copy()
-    m[~moving] = 0.0  # "no area, no motion": 0 * (C P / 0) is NaN on the boundary rows
-    for _ in range(iterations):
-        P = P + tau * moving[:, None] * (C @ P) / m[:, None]
-    return P
-
-
-NAN_MISTAKES = {
-    # each exercise's NaN gets the hint of its own likely cause, not another exercise's
-    "explicit step, dense 1 / M": (
-        check.explicit_step,
-        lambda P, M, C, tau: P + tau * (1 / M.toarray()) @ (C @ P),
-        "not by a dense 1 / M",
-    ),
-    "loop, boundary areas zeroed": (check.smoothing_loop, zeroed_boundary_areas, "areas zeroed on the boundary rows"),
-    "implicit step, dense 1 / M": (
-        check.implicit_step,
-        lambda P, M, C, tau: solve(np.eye(len(P)) - tau * (1 / M.toarray()) @ C.toarray(), P),
-        "the system's matrix holds infinities",
-    ),
-}
-
-
-@pytest.mark.parametrize("name", NAN_MISTAKES)
-@pytest.mark.filterwarnings("ignore::RuntimeWarning", "ignore::scipy.sparse.linalg.MatrixRankWarning")
-def test_nan_positions_are_told_their_own_cause(name):
-    run_check, fn, phrase = NAN_MISTAKES[name]
-    assert_diagnosed(run_check(fn), "NaN or infinite positions", phrase)
+def test_the_checks_pass_whatever_the_seed():
+    for seed in (0, 1, 2):
+        assert check.lam_max.evaluate(power, seed=seed).passed
+        assert check.smoothing_loop.evaluate(explicit, seed=seed).passed
+        assert check.implicit_loop.evaluate(implicit, seed=seed).passed

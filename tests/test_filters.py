@@ -51,6 +51,27 @@ def test_plot_draws_every_scheme_and_the_eigenvalue_band():
     assert len(ax.patches) == 1 and ax.patches[0].get_label() == "this mesh's eigenvalues"
 
 
+def test_a_taubin_pair_that_rises_above_1_gets_a_zoom_where_the_rise_is_seen():
+    # 05's pair (tau, -1.05 tau): the factor exceeds 1 by at most 0.05^2 / (4 * 1.05) = 0.000595, invisible
+    # on axes from -2.2 to 1.2; the zoom's y range is 1.8 times the rise, so the rise fills most of it
+    tau = 0.01
+    ax = plot_mode_factors(2.0, 50.0, tau, taubin=(tau, -1.05 * tau))
+    zoom = [other for other in ax.figure.axes if other is not ax]
+    assert len(zoom) == 1
+    lo, hi = zoom[0].get_ylim()
+    top = 1 + 0.05**2 / (4 * 1.05)
+    assert lo < 1 < top < hi and (top - 1) / (hi - lo) > 0.5
+    (curve,) = [line for line in zoom[0].get_lines() if line.get_label().startswith("_") and len(line.get_xdata()) > 2]
+    assert np.isclose(curve.get_ydata().max(), top, atol=1e-7)
+    label = next(line.get_label() for line in ax.get_lines() if line.get_label().startswith("Taubin"))
+    assert "(0.01, -0.0105)" in label and r"$|\tau_{inflate}| > \tau_{shrink}$" in label
+    # a pair with |tau_inflate| <= tau_shrink (07's (tau, -tau)) never exceeds 1: no zoom, and the label says so
+    ax = plot_mode_factors(2.0, 50.0, tau, taubin=(tau, -tau))
+    assert ax.figure.axes == [ax]
+    label = next(line.get_label() for line in ax.get_lines() if line.get_label().startswith("Taubin"))
+    assert "at most 1" in label and mode_factor(np.linspace(0, 60, 100), tau, "taubin", -tau).max() <= 1
+
+
 def test_explicit_damps_more_than_diffusion_in_magnitude_only_below_x_1_2785():
     # the module docstring: the signed chain holds for every x > 0, the magnitudes cross at x = 1.2785
     x = np.linspace(1e-3, 1.999, 4000)

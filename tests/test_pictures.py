@@ -45,17 +45,18 @@ def test_05_the_top_eigenvector_is_seen_where_it_lives():
 MEASURE_06 = """
 import json
 rows = []
+slider_steps, value, view, top_count = knobs.positions, knobs.value, knobs.view, knobs.controls["iterations"].max
 chosen = [slider_steps[0], value, slider_steps[-1]]
-runs = [(s, n, keep, "fixed") for s in slider_steps for n in (1, ITERATIONS, iter_slider.max) for keep in (False, True)]
-runs += [(s, iter_slider.max, keep, "rebuilt") for s in chosen for keep in (False, True)]
+runs = [(s, n, keep, "fixed") for s in slider_steps for n in (1, ITERATIONS, top_count) for keep in (False, True)]
+runs += [(s, top_count, keep, "rebuilt") for s in chosen for keep in (False, True)]
 for s, n, keep, op in runs:
-    update(s, n, keep, op)
+    knobs.update(s, n, keep, op)
     picture = view.still()[18 : 18 + view.height] if view.title else view.still()[: view.height]
     ink = (picture < 245).any(axis=2)
     rows.append(dict(step=float(s), n=n, keep=keep, op=op, pixels=int(ink.sum()),
                      border=int(ink[0].sum() + ink[-1].sum() + ink[:, 0].sum() + ink[:, -1].sum()),
                      title=view._title.value))
-update(value, 0, False, "fixed")
+knobs.update(value, 0, False, "fixed")
 input_pixels = int((view.still()[18 : 18 + view.height] < 245).any(axis=2).sum())
 print(json.dumps(dict(rows=rows, input=input_pixels, top=float(slider_steps[-1] / value))))
 """
@@ -88,5 +89,28 @@ def test_07_says_the_assignments_noise_tangles_the_mesh_and_shows_a_level_that_d
     assert "At $\\sigma$ = 0.005 (0.23 mean edges) they are 25.2° off: a surface, the second row." in text
     cell = next(c for c in run.notebook.cells if c.get("id") == "nb07-008")
     alts = [out["metadata"]["image/png"]["alt"] for out in cell.outputs if "image/png" in out.get("data", {})]
-    assert len(alts) == 2 and "3D view of noisy, sigma 0.005" in alts[1]
+    assert len(alts) == 2 and "3D view of noisy, sigma 0.005" in alts[1] and "Faces 25.2 degrees off" in alts[1]
     assert not run.notes, run.notes
+
+
+def test_01_the_flat_plane_is_white_over_its_colour_bar():
+    run = ran("01_uniform_laplace_curvature.ipynb")
+    for cell_id in ("08d83201", "0f1b474c"):  # the rows of uniform H and of K: the plane left
+        still, alt = _still(run, cell_id)
+        plane = still[:, :380]
+        render = plane[18 : 18 + 340]
+        drawn = render[np.any(render < 250, axis=2) & ~_coloured(render)]  # the surface but its violet NaN rim
+        assert np.median(drawn) > 220, cell_id  # white, as the text calls zero (a light at the eye drew it 156)
+        bar = plane[18 + 340 + 6 + 5, 60:-60].astype(int)  # the colour bar's middle row
+        assert bar[:, 2].max() - bar[:, 0].min() > 100, cell_id  # drawn: blue to red, 0 white between
+        assert "0 everywhere" in alt
+
+
+def test_02_the_slider_plot_is_a_picture_on_nbgraders_feedback_pages(monkeypatch):
+    # while nbgrader runs a notebook a widget is text on the static feedback page: "VBox(children=...)"
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    run = ran("02_fundamental_forms.ipynb")
+    still, alt = _still(run, "93d15836")
+    assert still.shape[0] > 150 and 0.01 < (still < 128).any(axis=2).mean() < 0.3  # a plot: its lines, axes, text
+    assert alt.startswith("Line plot of the normal curvature at (a, 0, 0)")
+    assert "VBox(" not in run.outputs_text()

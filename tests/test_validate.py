@@ -293,3 +293,40 @@ def test_faces_repeating_a_vertex_are_found_in_one_place():
     assert as_faces(G, len(V), allow_repeated=True) is not None
     with pytest.raises(MeshError, match="2 faces repeat a vertex"):
         as_faces(G, len(V))
+
+
+# ---------------------------------------------------------------- scalar arguments
+
+
+def test_real_number_takes_finite_reals_in_range_and_names_the_rest():
+    from geomlib.mesh.validate import real_number
+
+    assert real_number("tau", np.float32(0.5), 0) == 0.5 and real_number("tau", 0, 0) == 0.0
+    assert real_number("jitter", 0.25, 0, below=0.5) == 0.25
+    for value, said in [
+        (True, "tau must be a real number, not bool True"),
+        ("0.1", "tau must be a real number, not str '0.1'"),
+        (float("nan"), "tau must be finite, not nan"),
+        (-1e-9, "tau must be >= 0 (why), not -1e-09"),
+    ]:
+        with pytest.raises(MeshError) as err:
+            real_number("tau", value, 0, why=" (why)" if value == -1e-9 else "")
+        assert str(err.value) == said
+    with pytest.raises(MeshError, match=r"r must be > 0, not 0"):
+        real_number("r", 0, 0, strict=True)
+    with pytest.raises(MeshError, match=r"jitter must be below 0.5, not 0.5"):
+        real_number("jitter", 0.5, 0, below=0.5)
+
+
+def test_whole_number_takes_integers_in_range_and_names_the_rest():
+    from geomlib.mesh.validate import whole_number
+
+    assert whole_number("k", np.int64(3), 1, 5) == 3 and type(whole_number("k", np.int64(3), 1)) is int
+    with pytest.raises(MeshError, match=r"iterations must be an integer \(a whole number\), not float 2.0"):
+        whole_number("iterations", 2.0)
+    with pytest.raises(MeshError, match=r"iterations must be an integer \(a whole number\), not bool True"):
+        whole_number("iterations", True)
+    with pytest.raises(MeshError, match=r"k must be at least 1, not 0"):
+        whole_number("k", 0, 1)
+    with pytest.raises(MeshError, match=r"k = 6 is more than 5 \(five\)"):
+        whole_number("k", 6, 1, 5, why=" (five)")

@@ -627,6 +627,25 @@ def test_a_field_zero_up_to_rounding_draws_white(sphere):
     assert not MeshView(V, F, values=rounding, symmetric=True, zero_tol=0.0).is_zero
 
 
+def test_a_zero_field_in_a_given_range_shows_that_ranges_colour_bar(sphere):
+    V, F = sphere
+    view = MeshView(V, F, values=np.zeros(len(V)), symmetric=True, vmin=-2.0, vmax=2.0, label="H (1/length)", title="H")
+    assert view.is_zero and "linear-gradient" in view._colorbar.value and "0 everywhere" in view._colorbar.value
+    still = view.still()
+    bar = still[18 + view.height + 6 + 5, 40:-40].astype(int)  # the bar's middle row, inside its frame
+    assert bar[:, 2].max() - bar[:, 0].min() > 100  # blue to red, with white between: the bar is drawn
+    middle = bar[len(bar) // 2 - 3 : len(bar) // 2 + 3]
+    assert (middle > 235).all()  # its middle, 0, is the white of the surface
+    # a flat grid seen from the default camera (a plane's H in notebook 01): its white reads as white,
+    # not the mid-grey (156 of 255) of a light at the eye
+    from geomlib.teaching.shapes import surfaces
+
+    grid = surfaces.plane(n=8)
+    flat = MeshView(grid.V, grid.F, values=np.zeros(len(grid.V)), symmetric=True, vmin=-1.0, vmax=1.0, title="plane")
+    surface = flat.still()[18 : 18 + flat.height]
+    assert np.median(surface[np.any(surface < 250, axis=2)]) > 220
+
+
 def test_zero_field_keeps_nan_violet(sphere):
     V, F = sphere
     values = np.zeros(len(V))

@@ -14,9 +14,9 @@ import numpy as np
 from ..mesh.errors import MeshError
 from ..mesh.geometry import bounding_box_diagonal, vertex_normals
 from ..mesh.topology import boundary_vertices
-from ..mesh.validate import as_mesh, check_choice
+from ..mesh.validate import as_mesh, check_choice, real_number, whole_number
 from ..numerics.factor import factorise
-from .laplace import laplacian
+from .laplace import assemble_laplacian
 from .metrics import vertex_rms
 from .smoothing import explicit_smoothing, implicit_smoothing, implicit_step
 
@@ -53,12 +53,7 @@ def add_noise(V, F, sigma, seed, direction="isotropic"):
     (n, 3) float64, a new array.
     """
     V, F = as_mesh(V, F)
-    try:
-        sigma = float(sigma)
-    except (TypeError, ValueError):
-        raise MeshError(f"sigma must be a number (a fraction of the bounding-box diagonal), got {sigma!r}") from None
-    if not np.isfinite(sigma) or sigma < 0:
-        raise MeshError(f"sigma must be finite and >= 0 (a fraction of the bounding-box diagonal), got {sigma}")
+    sigma = real_number("sigma", sigma, 0, why=" (a fraction of the bounding-box diagonal)")
     check_choice("direction", direction, DIRECTIONS)
     if seed is None:
         raise MeshError("seed is required: pass an integer so that the noise can be reproduced")
@@ -125,9 +120,8 @@ def denoising_sweep(W, F, V_clean, taus, iterations):
     taus = [float(t) for t in taus]
     if not taus or not all(np.isfinite(t) and t > 0 for t in taus):
         raise MeshError(f"taus must be one or more finite steps > 0, got {taus}")
-    if int(iterations) != iterations or iterations < 0:
-        raise MeshError(f"iterations must be an integer >= 0, got {iterations!r}")
-    M, C = laplacian(W, F)
+    iterations = whole_number("iterations", iterations, 0)
+    M, C = assemble_laplacian(W, F)
     E = np.empty((len(taus), int(iterations) + 1))
     for i, tau in enumerate(taus):
         solve = factorise(M - tau * C).solve  # once per step, reused by every iteration

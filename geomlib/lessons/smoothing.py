@@ -36,7 +36,6 @@ faces) has no Laplacian: every function raises MeshError naming it and the call
 that removes it.
 """
 
-import numbers
 import warnings
 
 import numpy as np
@@ -44,7 +43,7 @@ import numpy as np
 from ..mesh.errors import MeshError, MeshWarning, format_indices
 from ..mesh.geometry import bounding_box_diagonal, surface_area, volume_and_centroid
 from ..mesh.topology import boundary_vertices
-from ..mesh.validate import as_mesh, check_choice
+from ..mesh.validate import as_mesh, check_choice, real_number, whole_number
 from ..numerics.factor import factorise
 from ..numerics.progress import Iterations
 from .laplace import check_options
@@ -193,24 +192,11 @@ def fixed_point(V, F, weights="cotan", area="barycentric"):
 
 
 def _check_tau(tau, name="tau"):
-    if isinstance(tau, (bool, np.bool_)) or not isinstance(tau, numbers.Real):
-        raise MeshError(f"{name} must be a real number, not {type(tau).__name__} {tau!r}")
-    tau = float(tau)
-    if not np.isfinite(tau):
-        raise MeshError(f"{name} must be finite, not {tau!r}")
-    if tau < 0:
-        raise MeshError(
-            f"{name} must be >= 0 (a negative step runs the heat flow backwards and is unstable), not {tau!r}"
-        )
-    return tau
+    return real_number(name, tau, 0, why=" (a negative step runs the heat flow backwards and is unstable)")
 
 
 def _check_iterations(iterations):
-    if isinstance(iterations, (bool, np.bool_)) or not isinstance(iterations, numbers.Integral):
-        raise MeshError(f"iterations must be a whole number, not {type(iterations).__name__} {iterations!r}")
-    if iterations < 0:
-        raise MeshError(f"iterations must be >= 0, not {iterations}")
-    return int(iterations)
+    return whole_number("iterations", iterations, 0)
 
 
 def _tau_or_step(tau, step):

@@ -36,7 +36,7 @@ import scipy.sparse as sp
 from scipy.sparse import csgraph
 
 from ..mesh.errors import MeshError, MeshWarning
-from ..mesh.validate import as_mesh
+from ..mesh.validate import as_mesh, whole_number
 from ..numerics import eigenbasis_store as basis_cache
 from ..numerics.eigen import one_blas_thread, smallest_eigenpairs
 from .laplace import assemble_laplacian, check_options
@@ -169,16 +169,7 @@ def eigenpairs(M, C, k, *, method="auto", tol=1e-10):
 
 
 def _check_k(k, n):
-    if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
-        raise MeshError(f"k must be an integer number of eigenpairs, not {k!r}")
-    k = int(k)
-    if k < 1:
-        raise MeshError(f"k must be at least 1, not {k}")
-    if k > n:
-        raise MeshError(
-            f"k = {k} eigenpairs asked for, but the mesh has only {n} vertices (at most n = {n} eigenpairs exist)"
-        )
-    return k
+    return whole_number("k", k, 1, n, why=f" (the mesh has only {n} vertices: at most n = {n} eigenpairs exist)")
 
 
 def _check_method(method):
@@ -283,9 +274,7 @@ class SpectralBasis:
     def _k(self, k):
         if k is None:
             return self.k
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= self.k:
-            raise MeshError(f"k must be an integer in 1..{self.k} (the eigenpairs in this basis), not {k!r}")
-        return int(k)
+        return whole_number("k", k, 1, self.k, why=f" (this basis holds the eigenpairs 1..{self.k})")
 
     def coefficients(self, X):
         """Spectral coefficients ``E^T M X`` (k, ...) of per-vertex values X (n,) or (n, d).

@@ -11,13 +11,17 @@
 * :func:`is_zero_area` is the package's one test for a zero-area triangle
   (:func:`geomlib.mesh.geometry.zero_area_faces` lists them).
 * :func:`check_choice` is the package's one check of an option that takes one
-  of a few named values (``weights=``, ``area=``, ``scheme=``, ...).
+  of a few named values (``weights=``, ``area=``, ``scheme=``, ...);
+  :func:`real_number` and :func:`whole_number` are its checks of a scalar argument
+  (a step, a noise level, a count, a resolution).
 
 The report of mesh properties that do not stop a computation (boundaries,
 non-manifold parts, components, ...) is :func:`geomlib.mesh.report.check_mesh`.
 """
 
 from __future__ import annotations
+
+import numbers
 
 import numpy as np
 
@@ -30,6 +34,8 @@ __all__ = [
     "repeated_vertex_faces",
     "is_zero_area",
     "check_choice",
+    "real_number",
+    "whole_number",
     "ZERO_AREA_RTOL",
 ]
 
@@ -217,3 +223,39 @@ def check_choice(name, value, choices):
         return value
     listed = ", ".join(repr(c) for c in choices)
     raise MeshError(f"{name} must be one of {listed}, not {value!r}")
+
+
+def real_number(name, value, minimum=None, *, strict=False, below=None, why=""):
+    """``value`` as a float, after checking that it is a finite real number (not a bool), at least
+    ``minimum`` (above it, when ``strict``) and below ``below``; otherwise MeshError naming the
+    argument, the rule (with ``why``, its reason) and the value.
+
+    >>> real_number("tau", 0.5, 0)
+    0.5
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise MeshError(f"{name} must be a real number{why}, not {type(value).__name__} {value!r}")
+    x = float(value)
+    if not np.isfinite(x):
+        raise MeshError(f"{name} must be finite{why}, not {value!r}")
+    if minimum is not None and (x <= minimum if strict else x < minimum):
+        raise MeshError(f"{name} must be {'>' if strict else '>='} {minimum:g}{why}, not {value!r}")
+    if below is not None and not x < below:
+        raise MeshError(f"{name} must be below {below:g}{why}, not {value!r}")
+    return x
+
+
+def whole_number(name, value, minimum=0, maximum=None, *, why=""):
+    """``value`` as an int, after checking that it is an integer (not a bool) from ``minimum`` to
+    ``maximum``; otherwise MeshError naming the argument, the rule (with ``why``, its reason) and the value.
+
+    >>> whole_number("iterations", 3)
+    3
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise MeshError(f"{name} must be an integer (a whole number){why}, not {type(value).__name__} {value!r}")
+    if value < minimum:
+        raise MeshError(f"{name} must be at least {minimum}{why}, not {value}")
+    if maximum is not None and value > maximum:
+        raise MeshError(f"{name} = {value} is more than {maximum}{why}")
+    return int(value)

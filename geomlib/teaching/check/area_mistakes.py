@@ -1,10 +1,9 @@
 """The vertex-area mistakes as data: one catalogue per area asked, the same words for every check that uses A_i.
 
-Three checks meet a learner's vertex areas: ``vertex_areas`` and ``mixed_areas`` (notebook 03)
-return them, ``cotangent_laplacian`` (03) puts them on the diagonal of M, and
+Two checks meet a learner's vertex areas: ``mixed_areas`` (notebook 03) returns them, and
 ``gaussian_curvature`` (01) divides the angle deficit by them. Each reads
 :data:`AREA_MISTAKES` (``Wrong`` entries of ``check.catalogue``, built from a case's V and F)
-through the one matcher, so the three name a mistake in the same words::
+through the one matcher, so the two name a mistake in the same words::
 
     judge(AREA_MISTAKES["barycentric"], cases, answers, right=lambda c: barycentric_areas(c.V, c.F))
 

@@ -2,7 +2,7 @@
 
 A still is what a page without a live front-end shows (nbval, exported HTML,
 repository previews, nbgrader feedback): the mesh drawn from the view's first
-camera, shaded by the same head light as the live view, with the title above
+camera, shaded by the same light as the live view, with the title above
 and the colour bar with its range below. The camera geometry (framing,
 distance, orientation) and the vertex normals are shared with the live view
 (:mod:`.viewer`), so both show the same picture.
@@ -46,6 +46,11 @@ VIEWS = {
 UP, VIEW_DIRECTION = VIEWS["z"]
 #: vertical field of view of the camera in degrees
 FOV = 30.0
+#: the light comes from the eye raised by this much along the camera's up (tan of about 37 degrees):
+#: a surface seen from above at a low angle, as every height field from the default camera, faces
+#: it and keeps its colour; a light at the eye made the white of a zero field on a plane a mid-grey
+#: (|n . e| = 0.4 there, shade 0.61)
+LIGHT_RAISE = 0.75
 
 
 # ----------------------------------------------------------------------------
@@ -121,7 +126,7 @@ def render_still(
     closed, outward-oriented mesh (half the work; nothing visible changes).
 
     A z-buffer rasteriser in numpy: vertices are projected with the camera of
-    the 3D view, shaded by the same head light (|n . e|, both sides lit), and
+    the 3D view, shaded by the same light (from the eye, raised by ``LIGHT_RAISE``; both sides lit), and
     every triangle's pixel centres are found row by row (:func:`fragments`);
     the nearest candidate per pixel wins (depth tested with interpolated 1/z).
     Colours are interpolated (Gouraud). ``edges`` (k, 2) int64 vertex pairs are
@@ -148,8 +153,12 @@ def render_still(
         normals = view_normals(V, F)
     to_eye = eye - P
     to_eye /= np.linalg.norm(to_eye, axis=1, keepdims=True)
-    d = np.abs(np.einsum("ij,ij->i", normals, to_eye))
-    shade = 0.35 + 0.65 * d
+    facing = np.einsum("ij,ij->i", normals, to_eye)
+    d = np.abs(facing)  # both sides lit: the normal turned towards the eye
+    light = to_eye + LIGHT_RAISE * up
+    light /= np.linalg.norm(light, axis=1, keepdims=True)
+    lit = np.maximum(np.sign(facing) * np.einsum("ij,ij->i", normals, light), 0.0)
+    shade = 0.35 + 0.65 * lit
     vc = np.asarray(colors, dtype=np.float64)[:, :3] * shade[:, None] + 0.12 * (d**40)[:, None]
     inv = 1.0 / depth
 

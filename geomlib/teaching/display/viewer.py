@@ -58,8 +58,10 @@ small message and is only sent when the printed range changes (pass fixed
 
 Lighting
 --------
-The surface is shaded by a small shader with a head light (light from the
-viewer's eye, both sides of the surface lit), not by three.js lights: a
+The surface is shaded by a small shader with a light that moves with the camera
+(from the viewer's eye, raised a little along the camera's up, so that a
+surface seen from above at a low angle faces it; both sides of the surface
+lit), not by three.js lights: a
 ``DirectionalLight`` or ``PointLight`` makes pythreejs log "Error setting state:
 t.on is not a function" once per view in the browser console (harmless, nothing
 visible is wrong), and a light fixed to the camera cannot be shared by views
@@ -140,6 +142,7 @@ from .colours import (
 from .frontends import enable_colab_widgets
 from .stills import (
     FOV,
+    LIGHT_RAISE,
     UP,
     VIEWS,
     bounding_frame,
@@ -152,7 +155,16 @@ from .stills import (
     view_normals,
 )
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only", "setup_display"]
+__all__ = [
+    "MeshView",
+    "ViewRow",
+    "side_by_side",
+    "box_still",
+    "box_alt",
+    "stills_only",
+    "register_still",
+    "setup_display",
+]
 
 #: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
 #: of the largest one is drawn enlarged to the largest one's size
@@ -177,7 +189,8 @@ void main() {
 }
 """
 
-# head light: diffuse from the eye plus a little specular; back faces lit too
+# a light at the eye raised along the camera's up (stills.LIGHT_RAISE), diffuse, plus a little
+# specular from the eye; back faces lit too
 _FRAGMENT_SHADER = """
 varying vec3 vColor;
 varying vec3 vNormal;
@@ -186,11 +199,12 @@ void main() {
     vec3 n = normalize(vNormal);
     if (!gl_FrontFacing) n = -n;
     vec3 e = normalize(vEye);
-    float d = max(dot(n, e), 0.0);
-    float s = pow(d, 40.0);
+    vec3 l = normalize(e + vec3(0.0, LIGHT_RAISE, 0.0));
+    float d = max(dot(n, l), 0.0);
+    float s = pow(max(dot(n, e), 0.0), 40.0);
     gl_FragColor = vec4(vColor * (0.35 + 0.65 * d) + vec3(0.12 * s), 1.0);
 }
-"""
+""".replace("LIGHT_RAISE", f"{LIGHT_RAISE:.4f}")
 
 
 # ----------------------------------------------------------------------------
@@ -573,10 +587,16 @@ class MeshView:
         if self._values is None:
             return ""
         n_nan = int(np.isnan(self._values).sum())
-        if self.is_zero:
-            return zero_html(self._zero_text(), self.label or "", self.width)
         lo, hi = self.range
-        return colorbar_html(self._lut, lo, hi, self.label or "", n_nan, self.width)
+        if self.is_zero and not self._zero_on_a_bar():
+            return zero_html(self._zero_text(), self.label or "", self.width)
+        label = f"{self.label or 'values'}: {self._zero_text()}" if self.is_zero else self.label or ""
+        return colorbar_html(self._lut, lo, hi, label, n_nan, self.width)
+
+    def _zero_on_a_bar(self):
+        """A zero field with a colour range given (vmin and vmax, as for a row of views sharing one) shows
+        that range's colour bar, so that its white reads as the bar's middle, 0."""
+        return self.is_zero and None not in self._fixed and self.range[1] > self.range[0]
 
     def _zero_text(self):
         largest = float(np.nanmax(np.abs(self._values)))
@@ -685,7 +705,8 @@ class MeshView:
             edges=None if self.wireframe is None else edges(self._triangles),
         )
         lo, hi = self.range
-        lut = self._lut if self._values is not None and not self.is_zero else None
+        bar = self._values is not None and (not self.is_zero or self._zero_on_a_bar())
+        lut = self._lut if bar else None
         title = self.title
         if title and self._size_note():
             title = f"{title} ({self._size_note()})"
@@ -751,6 +772,12 @@ class ViewRow:
 # widget model id -> the MeshView or ViewRow that made the widget (weak: a
 # view the notebook dropped is not kept alive for its picture)
 _SHOWN = weakref.WeakValueDictionary()
+
+
+def register_still(widget, shown):
+    """Let a box holding ``widget`` be drawn as ``shown.still()`` ((h, w, 3) uint8), described by
+    ``shown.alt_text()``: what :func:`box_still` and :func:`box_alt` find for it, as for a view."""
+    _SHOWN[widget.model_id] = shown
 
 
 def box_still(box):

@@ -50,7 +50,7 @@ import numpy as np
 
 from ...mesh.errors import MeshError, format_indices
 from ...mesh.geometry import face_cross, zero_area_faces
-from ...mesh.validate import check_choice
+from ...mesh.validate import check_choice, real_number, whole_number
 
 __all__ = [
     "AnalyticMesh",
@@ -163,42 +163,17 @@ class AnalyticMesh:
 
 
 def _positive(name, value):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise MeshError(f"{name} must be a positive number, got {value!r}") from None
-    if not np.isfinite(x) or x <= 0:
-        raise MeshError(f"{name} must be a positive finite number, got {value!r}")
-    return x
-
-
-def _finite(name, value):
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise MeshError(f"{name} must be a finite number, got {value!r}") from None
-    if not np.isfinite(x):
-        raise MeshError(f"{name} must be a finite number, got {value!r}")
-    return x
+    return real_number(name, value, 0, strict=True, why=" (a positive length)")
 
 
 def _count(name, value, minimum, maximum=2048):
     """An integer resolution in [minimum, maximum]; the upper bound keeps a
     typo (subdivisions=12: 168 million vertices) from exhausting memory."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise MeshError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    if value < minimum:
-        raise MeshError(f"{name} must be >= {minimum}, got {value}")
-    if value > maximum:
-        raise MeshError(f"{name} = {value} is more than the limit {maximum} (too many vertices)")
-    return int(value)
+    return whole_number(name, value, minimum, maximum, why=" (a resolution: more would be too many vertices)")
 
 
 def _jitter(value):
-    j = _finite("jitter", value)
-    if not 0.0 <= j < 0.5:
-        raise MeshError(f"jitter must be in [0, 0.5) (a fraction of the local edge length), got {value!r}")
-    return j
+    return real_number("jitter", value, 0, below=0.5, why=" (a fraction of the local edge length, in [0, 0.5))")
 
 
 def _rng(seed):
@@ -480,8 +455,8 @@ def saddle(n=48, size=2.0, amplitude=0.2, monkey=0.1, jitter=0.0, seed=0, diagon
     """
     n = _count("n", n, 2)
     size = _positive("size", size)
-    A = _finite("amplitude", amplitude)
-    B = _finite("monkey", monkey)
+    A = real_number("amplitude", amplitude)
+    B = real_number("monkey", monkey)
     jitter = _jitter(jitter)
     x, y = _square_grid(n, size, jitter, seed)
     V = np.stack([x, y, saddle_height(x, y, A, B)], axis=1)
@@ -883,7 +858,7 @@ def attach_truth(name, V, F, **params):
         uv = V[:, :2].copy()
         truth = _constant_truth(n, np.array([0.0, 0.0, 1.0]), 0.0, 0.0)
     elif name == "saddle":
-        A, B = _finite("amplitude", p["amplitude"]), _finite("monkey", p["monkey"])
+        A, B = real_number("amplitude", p["amplitude"]), real_number("monkey", p["monkey"])
         x, y = V[:, 0], V[:, 1]
         dist = np.abs(V[:, 2] - saddle_height(x, y, A, B))
         scale = 1.0
