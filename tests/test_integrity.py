@@ -6,8 +6,8 @@ must say. The fast tests run each function-level cheat through the check in this
 process, where it can be refused (a student's interactive check). The slow ones build a
 small nbgrader course (01 and 03, with the course's one configuration line for
 ``geomlib.teaching.grading.JudgeExercises``) and let a real ``nbgrader autograde`` grade
-an honest student, a student with one typical mistake and three students who hand in
-the whole catalogue (five cheats each, one per exercise): every cheating exercise
+an honest student, a student with one typical mistake and four students who hand in
+the whole catalogue (four cheats each, one per exercise): every cheating exercise
 scores 0 and its feedback names what it did, while the honest student scores full
 points. A replay of answers recorded from one run's cases passes that run and fails the
 next (fresh cases each run). The step-limit cheat (``numerics.eigen.largest_eigenpair``,
@@ -42,21 +42,15 @@ REPLAY_SEED = 4182
 
 
 def pasted_copy():
-    """geomlib's intrinsic_cotangent_matrix pasted with its variables renamed, comments reworded."""
+    """geomlib's intrinsic_cotangent_matrix pasted as the answer, its variables renamed, comments reworded."""
     source = inspect.getsource(__import__("geomlib.lessons.laplace", fromlist=["x"]).intrinsic_cotangent_matrix)
-    for old, new in (("intrinsic_cotangent_matrix", "cot_matrix"), ("dblA", "twice_area"), ("l2", "squared")):
+    for old, new in (("intrinsic_cotangent_matrix", "my_cotangent_matrix"), ("dblA", "twice_area"), ("l2", "squared")):
         source = source.replace(old, new)
     source = re.sub(r"  # .*", "  # mine", source)
     source = re.sub(r"\bdegenerate\b", "flat", source)
     return (
         "from geomlib.lessons.laplace import NEXT, PREV, warn_zero_area\n"
-        "from geomlib.mesh.validate import is_zero_area\n\n" + source + "\n\n"
-        "def my_cotangent_laplacian(V, F):\n"
-        "    e = [V[F[:, (c + 2) % 3]] - V[F[:, (c + 1) % 3]] for c in range(3)]\n"
-        "    l = np.stack([np.linalg.norm(x, axis=1) for x in e], axis=1)\n"
-        "    twice_area = np.linalg.norm(np.cross(e[0], e[1]), axis=1)\n"
-        "    M = sp.diags(np.bincount(F.ravel(), weights=np.repeat(twice_area / 6, 3), minlength=len(V)))\n"
-        "    return M, cot_matrix(l, F, len(V), twice_area)\n"
+        "from geomlib.mesh.validate import is_zero_area\n\n" + source
     )
 
 
@@ -90,6 +84,7 @@ def record_uniform_laplacian(seed):
 # name: (notebook, exercise, the solution cell handed in, what the judge says, what the kernel's check says
 # or None where the kernel cannot see it: the check object or the module replaced, a copy, a replay)
 CHEATS = {
+    # the first cheating student
     "the routine in a ThreadPoolExecutor worker": (
         "01",
         "uniform_laplacian",
@@ -110,36 +105,26 @@ CHEATS = {
         "calls sys.setprofile",
         "calls sys.setprofile",
     ),
-    "libigl's cotmatrix and massmatrix": (
+    "libigl's intrinsic cotmatrix": (
         "03",
-        "cotangent_laplacian",
-        "def my_cotangent_laplacian(V, F):\n"
-        "    import igl\n"
-        "    return igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC), igl.cotmatrix(V, F)\n",
+        "cotangent_matrix",
+        "def my_cotangent_matrix(l, F):\n    import igl\n    return igl.cotmatrix_intrinsic(l, F)\n",
         "imports igl",
         "imports igl",
-    ),
-    "geomlib's face_geometry for the vertex areas": (
-        "03",
-        "vertex_areas",
-        "def my_vertex_areas(V, F):\n"
-        "    l2, dblA, cot, flat = face_geometry(V, F)\n"
-        "    return np.bincount(F.ravel(), weights=np.repeat(dblA / 6, 3), minlength=len(V))\n",
-        "calls geomlib's `face_geometry`",
-        "calls geomlib's `face_geometry`",
     ),
     "geomlib's voronoi_pieces for the mixed areas": (
         "03",
         "mixed_areas",
         "def my_mixed_areas(V, F):\n"
+        "    from geomlib.lessons.laplace import voronoi_pieces\n"
         "    A_f = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1) / 2\n"
         "    pieces = voronoi_pieces(V, F)\n"
-        "    obtuse = pieces < 0\n"
-        "    per = np.where(obtuse.any(axis=1, keepdims=True), A_f[:, None] / 4, pieces)\n"
+        "    per = np.where((pieces < 0).any(axis=1, keepdims=True), A_f[:, None] / 4, pieces)\n"
         "    return np.bincount(F.ravel(), weights=per.ravel(), minlength=len(V))\n",
         "calls geomlib's `voronoi_pieces`",
         "calls geomlib's `voronoi_pieces`",
     ),
+    # the second
     "a replay of recorded answers": (
         "01",
         "uniform_laplacian",
@@ -164,60 +149,28 @@ CHEATS = {
         "calls geomlib's `face_angles`",
         "calls geomlib's `face_angles`",
     ),
+    "a pasted copy of geomlib's routine, variables renamed": (
+        "03",
+        "cotangent_matrix",
+        None,
+        "a copy of geomlib's code earns no points",
+        "calls geomlib's `",
+    ),
     "geomlib's face_geometry for the cotangent weights": (
         "03",
-        "cotangent_laplacian",
-        "def my_cotangent_laplacian(V, F):\n"
+        "mixed_areas",
+        "def my_mixed_areas(V, F):\n"
+        "    from geomlib.lessons.laplace import face_geometry\n"
         "    l2, dblA, cot, flat = face_geometry(V, F)\n"
-        "    n = len(V)\n"
-        "    C = sp.csr_matrix((n, n))\n"
-        "    for c in range(3):\n"
-        "        half = sp.csr_matrix((cot[:, c] / 2, (F[:, (c + 1) % 3], F[:, (c + 2) % 3])), shape=(n, n))\n"
-        "        C = C + half + half.T\n"
-        "    C = C - sp.diags(np.asarray(C.sum(axis=1)).ravel())\n"
-        "    return sp.diags(np.bincount(F.ravel(), weights=np.repeat(dblA / 6, 3), minlength=n)), C\n",
+        "    lc = l2 * cot\n"
+        "    voronoi = (lc[:, [1, 2, 0]] + lc[:, [2, 0, 1]]) / 8\n"
+        "    share = np.where(cot < 0, dblA[:, None] / 4, dblA[:, None] / 8)\n"
+        "    pieces = np.where((cot < 0).any(axis=1, keepdims=True), share, voronoi)\n"
+        "    return np.bincount(F.ravel(), weights=pieces.ravel(), minlength=len(V))\n",
         "calls geomlib's `face_geometry`",
         "calls geomlib's `face_geometry`",
     ),
-    "the check module replaced in sys.modules": (
-        "03",
-        "vertex_areas",
-        "import sys, types\n\n"
-        "class Passes:\n"
-        "    def __call__(self, fn):\n"
-        "        return None\n\n"
-        "    def partial_credit(self, fn):\n"
-        "        return None\n\n"
-        'sys.modules["geomlib.teaching.check"] = types.SimpleNamespace(\n'
-        "    cotangent_laplacian=Passes(), vertex_areas=Passes(), mixed_areas=Passes())\n"
-        "import geomlib.teaching.check as check\n\n"
-        "def my_vertex_areas(V, F):\n"
-        "    return np.zeros(len(V))\n",
-        "vertex_areas: ",
-        None,
-    ),
-    "check.NAME replaced from a solution cell": (
-        "03",
-        "mixed_areas",
-        "check.mixed_areas = lambda fn: None\n"
-        "check.mixed_areas.partial_credit = lambda fn: None\n\n"
-        "def my_mixed_areas(V, F):\n"
-        "    from geomlib.lessons.laplace import mixed_areas\n"
-        "    return mixed_areas(V, F)\n",
-        "calls geomlib's `mixed_areas`, which this exercise asks you to write",
-        None,
-    ),
-    "numpy and geomlib's comparison monkeypatched": (
-        "03",
-        "mixed_areas",
-        "import geomlib.teaching.check.result\n"
-        "np.allclose = lambda *args, **kwargs: True\n"
-        "geomlib.teaching.check.result.close = lambda *args, **kwargs: True\n\n"
-        "def my_mixed_areas(V, F):\n"
-        "    return np.full(len(V), 7.0)\n",
-        "mixed_areas: ",
-        None,
-    ),
+    # the third
     "geomlib's topology.edges and valence": (
         "01",
         "uniform_laplacian",
@@ -243,32 +196,79 @@ CHEATS = {
         "imports trimesh",
         "imports trimesh",
     ),
-    "a pasted copy of geomlib's routine, variables renamed": (
-        "03",
-        "cotangent_laplacian",
-        pasted_copy(),
-        "a copy of geomlib's code earns no points",
-        "calls geomlib's `",
-    ),
     "geomlib's source through inspect.getsource and exec": (
         "03",
-        "vertex_areas",
-        "def my_vertex_areas(V, F):\n"
+        "cotangent_matrix",
+        "def my_cotangent_matrix(l, F):\n"
         "    import inspect\n"
         "    from geomlib.lessons import laplace\n"
         "    ns = dict(vars(laplace))\n"
-        "    exec(inspect.getsource(laplace.barycentric_areas), ns)\n"
-        '    return ns["barycentric_areas"](V, F)\n',
+        "    exec(inspect.getsource(laplace.intrinsic_cotangent_matrix), ns)\n"
+        '    return ns["intrinsic_cotangent_matrix"](l, F)\n',
         "runs compile on code of its own",
         "calls geomlib's `",
     ),
+    "numpy and geomlib's comparison monkeypatched": (
+        "03",
+        "mixed_areas",
+        "import geomlib.teaching.check.result\n"
+        "np.allclose = lambda *args, **kwargs: True\n"
+        "geomlib.teaching.check.result.close = lambda *args, **kwargs: True\n\n"
+        "def my_mixed_areas(V, F):\n"
+        "    return np.full(len(V), 7.0)\n",
+        "mixed_areas: ",
+        None,
+    ),
+    # the fourth
+    "the check module replaced in sys.modules": (
+        "01",
+        "uniform_laplacian",
+        "import sys, types\n\n"
+        "class Passes:\n"
+        "    def __call__(self, fn):\n"
+        "        return None\n\n"
+        "    def partial_credit(self, fn):\n"
+        "        return None\n\n"
+        'sys.modules["geomlib.teaching.check"] = types.SimpleNamespace(uniform_laplacian=Passes(), gaussian_curvature=Passes())\n'
+        "import geomlib.teaching.check as check\n\n"
+        "def my_uniform_laplacian(V, F):\n"
+        "    return sparse.eye(len(V)), sparse.eye(len(V))\n",
+        "uniform_laplacian: ",
+        None,
+    ),
+    "libigl's gaussian_curvature": (
+        "01",
+        "gaussian_curvature",
+        "def my_gaussian_curvature(V, F):\n"
+        "    import igl\n"
+        "    A = np.bincount(F.ravel(), np.repeat(igl.doublearea(V, F) / 6, 3), minlength=len(V))\n"
+        "    return np.where(boundary_mask(V, F), np.nan, igl.gaussian_curvature(V, F) / A)\n",
+        "imports igl",
+        "imports igl",
+    ),
+    "check.NAME replaced from a solution cell": (
+        "03",
+        "cotangent_matrix",
+        "check.cotangent_matrix = lambda fn: None\n"
+        "check.cotangent_matrix.partial_credit = lambda fn: None\n\n"
+        "def my_cotangent_matrix(l, F):\n"
+        "    from geomlib.lessons.laplace import intrinsic_cotangent_matrix\n"
+        "    return intrinsic_cotangent_matrix(l, F)\n",
+        "calls geomlib's `intrinsic_cotangent_matrix`, which this exercise asks you to write",
+        None,
+    ),
+    "libigl's massmatrix (Voronoi)": (
+        "03",
+        "mixed_areas",
+        "def my_mixed_areas(V, F):\n"
+        "    import igl\n"
+        "    return igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()\n",
+        "imports igl",
+        "imports igl",
+    ),
 }
-# the three cheating students: each hands in one cheat per exercise of 01 and 03
-CHEATERS = {
-    "cheat_a": list(CHEATS)[0:5],
-    "cheat_b": list(CHEATS)[5:10],
-    "cheat_c": list(CHEATS)[10:15],
-}
+# four cheating students: each hands in one cheat per exercise of 01 and 03, in the order above
+CHEATERS = {f"cheat_{k}": list(CHEATS)[4 * k : 4 * k + 4] for k in range(4)}
 
 
 def solutions(nb_id):
@@ -292,15 +292,17 @@ def namespace(nb_id):
 
 def cheat_source(name, recorded=None):
     source = CHEATS[name][2]
-    return replayed(recorded) if source is None else source
+    if source is None:
+        return pasted_copy() if "pasted" in name else replayed(recorded)
+    return source
 
 
 @pytest.mark.parametrize("name", [n for n, c in CHEATS.items() if c[4] is not None])
 def test_the_kernels_check_refuses_the_cheats_it_can_see(name, monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "0")
-    nb_id, exercise, source, _, said = CHEATS[name]
+    nb_id, exercise, _, _, said = CHEATS[name]
     ns = namespace(nb_id)
-    exec(source, ns)
+    exec(cheat_source(name), ns)
     result = getattr(check, exercise).evaluate(ns[f"my_{exercise}"])
     assert not result.passed and not result.partial, result.message
     assert said in result.message and "earns no points" in result.message, result.message
