@@ -311,7 +311,7 @@ def test_the_kernels_check_refuses_the_cheats_it_can_see(name, monkeypatch):
 def test_a_copy_is_found_through_renamed_variables_and_a_one_liner_is_never_called_one():
     flags = copies.exercise_copies(pasted_copy())
     assert {
-        "function": "cot_matrix",
+        "function": "my_cotangent_matrix",
         "of": "geomlib",
         "matches": "geomlib.lessons.laplace.intrinsic_cotangent_matrix",
     } in flags
