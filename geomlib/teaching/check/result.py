@@ -204,14 +204,14 @@ class _Rules:
         self.fence = Fence(self.allow)
 
     def sentence(self):
-        tools = ", ".join(self.tools[:-1]) + f" and {self.tools[-1]}"
+        tools = list(self.tools)
         if self.allow:
-            tools = ", ".join(self.tools) + " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
-        named = ", ".join(f"`{_public(d)}`" for d in self.forbid)
+            tools[-1:] = [tools[-1], "geomlib's " + _listed([f"`{_public(d)}`" for d in self.allow])]
+        named = ", ".join(f"`{_public(d)}`" for d in self.forbid[:2])  # the nearest shortcuts
         such = f" (such as {named})" if named else ""
         return (
-            f"Ground rules: write it with {tools}. Any other geomlib routine{such}, a geometry library "
-            "(libigl, trimesh, gpytoolbox, ...) or a copy of geomlib's code earns no points."
+            f"Ground rules: {_listed(tools)} only; any other geomlib routine{such}, a geometry library "
+            "(libigl, trimesh, ...) or a copy of geomlib's code earns no points."
         )
 
     def refusal(self, name, why=""):
@@ -228,6 +228,11 @@ class _Rules:
 
 def _public(dotted):
     return dotted.rpartition(".")[2]
+
+
+def _listed(words):
+    """'a', 'a and b', 'a, b and c'."""
+    return ", ".join(words[:-1]) + (" and " if len(words) > 1 else "") + words[-1]
 
 
 _RULES = [None]  # the rules of the exercise being checked (checks run one at a time)
