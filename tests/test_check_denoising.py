@@ -77,6 +77,21 @@ WRONG_NOISE = {
         "length about s",
     ),
     "list": (lambda V, F, sigma, seed: noise_reference(V, F, sigma, seed).tolist(), "not a numpy array"),
+    "scaled by the largest corner": (
+        lambda V, F, sigma, seed: V + sigma * np.linalg.norm(V.max(axis=0)) * _normals(V, sigma, seed),
+        "largest corner",
+    ),
+    "one draw per vertex for x, y and z": (
+        lambda V, F, sigma, seed: (
+            V + sigma * bounding_box_diagonal(V) * np.random.default_rng(seed).standard_normal((len(V), 1))
+        ),
+        "move together",
+    ),
+    "float32": (lambda V, F, sigma, seed: noise_reference(V, F, sigma, seed).astype(np.float32), "float32"),
+    "float32 values in float64": (
+        lambda V, F, sigma, seed: noise_reference(V, F, sigma, seed).astype(np.float32).astype(float),
+        "float32",
+    ),
     "one coordinate": (
         lambda V, F, sigma, seed: V + sigma * bounding_box_diagonal(V) * _normals(V, sigma, seed) * [1, 1, 0],
         "not equally noisy",
@@ -250,9 +265,21 @@ WRONG_EXPERIMENTS = {
             ),
             relative,
         ),
-        "too small in square",
+        "sqrt(3) too small",
     ),
     "returns the meshes": (experiment(seeded, lambda P, W, V: (relative(P, W, V), P)), "not a number"),
+    "one iteration short": (
+        lambda V, F, s, tau, n, seed: experiment(seeded, relative)(V, F, s, tau, max(n - 1, 0), seed),
+        "one iteration short",
+    ),
+    "one iteration too many": (
+        lambda V, F, s, tau, n, seed: experiment(seeded, relative)(V, F, s, tau, n + 1, seed),
+        "one iteration too many",
+    ),
+    "mean over the 3n coordinates": (
+        experiment(seeded, lambda P, W, V: float(np.sqrt(np.mean((P - V) ** 2))) / bounding_box_diagonal(V)),
+        "3n coordinates",
+    ),
 }
 
 
@@ -282,3 +309,101 @@ def test_the_experiment_is_scale_free_and_its_error_at_zero_iterations_is_the_no
     E1 = geomlib.denoising_experiment(V, F, 0.02, tau, 3, seed=4)[0]
     E2 = geomlib.denoising_experiment(7 * V, F, 0.02, 49 * tau, 3, seed=4)[0]
     assert E1 == pytest.approx(E2, rel=1e-9) and E1 < E
+
+
+def test_the_noise_grid_tells_the_diagonal_from_the_largest_corner_and_the_edge():
+    from geomlib.teaching.check.denoising import _NOISE_F, _NOISE_V
+
+    d, corner = bounding_box_diagonal(_NOISE_V), np.linalg.norm(_NOISE_V.max(axis=0))
+    assert d == pytest.approx(357.1, abs=0.05) and geomlib.mean_edge_length(_NOISE_V, _NOISE_F) == pytest.approx(
+        5.72, abs=0.005
+    )
+    assert corner > 3 * d  # away from the origin: a noise scaled by |max(V)| is four times too large
+
+
+def test_the_experiment_tells_n_iterations_from_n_minus_one_exactly():
+    """Without noise the error is the shrinkage of N steps: N - 1 and N + 1 differ from it by far more than
+    the exact comparison allows, whatever the noise draw of the other runs."""
+    from geomlib.teaching.check.denoising import _EXACT, _e, _experiment_cases
+
+    (quiet,) = [c for c in _experiment_cases() if c.sigma == 0]
+    right = _e(quiet)
+    for n in (quiet.iterations - 1, quiet.iterations + 1):
+        assert abs(_e(quiet, iterations=n) - right) > 1000 * _EXACT * right
+
+
+# --- the sweep: the error of implicit smoothing after every count, for every step ---------------
+
+
+def sweep(variant=None):
+    """The sweep written fresh with numpy and scipy, right (None) or with one typical mistake."""
+    import scipy.sparse.linalg
+
+    def fn(W, F, V_clean, taus, iterations):
+        M, C = geomlib.laplacian(W, F, "uniform" if variant == "uniform" else "cotan")
+        truth = W if variant == "noisy" else V_clean
+        E, P = np.empty((len(taus), iterations + 1)), W
+        for i, tau in enumerate(taus):
+            solve = scipy.sparse.linalg.splu((M - tau * C).tocsc()).solve
+            P = P if variant == "carry" else W
+            E[i, 0] = rms_reference(P, truth)
+            for k in range(1, iterations + 1):
+                if variant == "rebuild":
+                    M, C = geomlib.laplacian(P, F)
+                    solve = scipy.sparse.linalg.splu((M - tau * C).tocsc()).solve
+                P = (
+                    P + tau * (C @ P) / M.diagonal()[:, None]
+                    if variant == "explicit"
+                    else solve(P if variant == "rhs" else M @ P)
+                )
+                E[i, k] = rms_reference(P, truth)
+        E = E[:, 1:] if variant == "no zero column" else E.T if variant == "transposed" else E
+        i, k = np.unravel_index((np.argmax if variant == "argmax" else np.argmin)(E), E.shape)
+        if variant == "index":
+            return i, int(k), E
+        return (
+            taus[i],
+            int(k) + (variant in ("one too many", "no zero column")),
+            E.tolist() if variant == "lists" else E,
+        )
+
+    return fn
+
+
+WRONG_SWEEPS = {
+    "noisy": "against the noisy mesh W",
+    "carry": "previous step's ended",
+    "rebuild": "rebuilt from the smoothed mesh",
+    "explicit": "explicit steps",
+    "rhs": "the right-hand side is P",
+    "uniform": "uniform weights",
+    "no zero column": "no column for 0 iterations",
+    "argmax": "largest error",
+    "one too many": "N_best is one too many",
+    "index": "the index of the best step",
+}
+
+
+@pytest.mark.parametrize("variant", [None, "lists"])
+def test_right_sweeps_pass(variant):
+    result = check.denoising_sweep(sweep(variant))
+    assert result.passed, result.message
+
+
+@pytest.mark.parametrize("variant", sorted(WRONG_SWEEPS))
+def test_wrong_sweeps_are_named_and_earn_partial_credit(variant):
+    result = check.denoising_sweep.evaluate(sweep(variant))
+    assert_diagnosed(result, WRONG_SWEEPS[variant], "Reread section 5 · The sweep, yours")
+    assert result.partial
+
+
+def test_geomlibs_own_sweep_is_refused_and_a_stub_is_not_written():
+    refused = check.denoising_sweep.evaluate(lambda W, F, V, taus, n: geomlib.denoising_sweep(W, F, V, taus, n))
+    assert_diagnosed(refused, "denoising_sweep")
+    assert not refused.partial
+
+    def stub(*args):
+        raise NotImplementedError("Your turn")
+
+    assert_diagnosed(check.denoising_sweep(stub), "not written yet")
+    assert_diagnosed(check.denoising_sweep(lambda *a: 0.5), "triple")

@@ -10,7 +10,7 @@ import pytest
 
 from geomlib import MeshError, MeshWarning
 from geomlib.mesh.geometry import enclosed_volume, mean_edge_length
-from geomlib.teaching.display.controls import live, mesh_warnings
+from geomlib.teaching.display.controls import live, live_figure, mesh_warnings
 from geomlib.teaching.display.glyphs import Glyphs, arrow_meshes, marker_meshes
 from geomlib.teaching.display.viewer import MeshView
 from geomlib.teaching.experiments.steps import MeshSteps, absolute_step, log_positions, log_slider
@@ -166,3 +166,33 @@ def test_glyphs_merge_into_one_mesh_with_one_value_each(meshes):
     np.testing.assert_array_equal(H2[: len(V)], H)
     assert (H2[len(V) : len(V) + 26] == 5.0).all() and np.isnan(H2[len(V) + 26 :]).all()
     np.testing.assert_allclose(V2[len(V) + 24], [0, 0, 2.0])  # the tip: size / 2 above the origin
+
+
+# --- a figure redrawn by sliders ------------------------------------------------
+
+
+def test_live_figure_is_a_still_picture_where_no_widget_front_end_runs(monkeypatch):
+    import matplotlib.pyplot as plt
+
+    from geomlib.teaching.display.viewer import box_still
+
+    def draw(k):
+        fig, ax = plt.subplots(figsize=(3, 2))
+        ax.plot([0, 1], [0, k], color="C3", lw=4)
+        ax.set_ylim(0, 3)
+        return fig, f"a line rising to {k:g}"
+
+    slider = ipywidgets.FloatSlider(value=1.0, min=0.0, max=3.0, description="k")
+    shown = live_figure(draw, {"k": slider})
+    assert isinstance(shown.widget, ipywidgets.VBox) and slider in shown.widget.children[0].children
+    low = shown.still()
+    assert low.ndim == 3 and low.shape[2] == 3 and shown.alt_text() == "a line rising to 1"
+    slider.value = 3.0  # the still follows the controls
+    high = shown.still()
+    assert shown.alt_text() == "a line rising to 3" and not np.array_equal(low, high)
+    # nbgrader's feedback pages: the figure as a PNG with its alt, no widget and no "VBox(...)" text
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    bundle, metadata = shown._repr_mimebundle_()
+    assert set(bundle) == {"image/png", "text/plain"} and metadata["image/png"]["alt"] == "a line rising to 3"
+    assert "VBox" not in bundle["text/plain"]
+    assert np.array_equal(box_still(shown.widget), high)  # the box alone, as display(box) gives it

@@ -104,3 +104,13 @@ def test_01_the_flat_plane_is_white_over_its_colour_bar():
         bar = plane[18 + 340 + 6 + 5, 60:-60].astype(int)  # the colour bar's middle row
         assert bar[:, 2].max() - bar[:, 0].min() > 100, cell_id  # drawn: blue to red, 0 white between
         assert "0 everywhere" in alt
+
+
+def test_02_the_slider_plot_is_a_picture_on_nbgraders_feedback_pages(monkeypatch):
+    # while nbgrader runs a notebook a widget is text on the static feedback page: "VBox(children=...)"
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    run = ran("02_fundamental_forms.ipynb")
+    still, alt = _still(run, "93d15836")
+    assert still.shape[0] > 150 and 0.01 < (still < 128).any(axis=2).mean() < 0.3  # a plot: its lines, axes, text
+    assert alt.startswith("Line plot of the normal curvature at (a, 0, 0)")
+    assert "VBox(" not in run.outputs_text()

@@ -245,13 +245,13 @@ def gaussian_curvature(V, F, area="barycentric", boundary="nan", integrated=Fals
     theta_sum, A = angle_and_area_sums(V, F, None if integrated else area)  # one pass over the faces
     K = deficit_of(V, F, theta_sum)  # 2 pi - sum theta
     if boundary != "deficit":
-        E, faces_at_edge = edges_at_unpaired_vertices(F, len(V))  # a closed mesh sorts nothing
-        b = np.bincount(E[faces_at_edge == 1].ravel(), minlength=len(V))  # boundary edges at each vertex
+        b = boundary_edge_counts(F, len(V))  # boundary edges at each vertex: the one boundary rule
         on_boundary = b > 0
         if boundary == "turning":
             K[on_boundary] -= 0.5 * np.pi * b[on_boundary]  # b = 2: pi - sum theta
         else:
             K[on_boundary] = np.nan if boundary == "nan" else 0.0
+        E, faces_at_edge = edges_at_unpaired_vertices(F, len(V))  # a closed mesh sorts nothing
         _warn_unusual_boundary(E[faces_at_edge > 2], on_boundary, boundary)
     if integrated:
         return K

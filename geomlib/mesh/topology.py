@@ -611,6 +611,10 @@ def _unpaired(F, n, block=PROBE_BLOCK):
 def boundary_edge_counts(F, n=None):
     """Number of boundary edges (edges of exactly one face) at each vertex, (n,) int64.
 
+    geomlib's one boundary rule: a vertex is on the boundary when this count is positive
+    (:func:`boundary_vertices`; ``geomlib.lessons.curvature.boundary_mask``; the curvature
+    functions' ``boundary=`` value and the smoothers' ``boundary_condition="fixed"`` apply there).
+
     0 at interior vertices, 2 at a simple boundary vertex, 2k where k open
     fans meet (a non-manifold "bow-tie"). Edges are counted only around the
     vertices whose half-edges do not pair up (:func:`unpaired_vertices`): on a

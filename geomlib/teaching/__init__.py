@@ -15,7 +15,7 @@ from importlib import import_module
 # public name -> module that defines it (imported on first use)
 _EXPORTS = {
     **dict.fromkeys(["reveal", "use"], "check"),
-    **dict.fromkeys(["live", "mesh_warnings"], "display.controls"),
+    **dict.fromkeys(["live", "live_figure", "mesh_warnings"], "display.controls"),
     **dict.fromkeys(["clipped", "explicit_explorer", "implicit_explorer"], "display.smoothing_controls"),
     **dict.fromkeys(["claim", "explain", "note", "prepare", "show_figure", "show_source"], "notebook"),
     **dict.fromkeys(["MeshSteps", "absolute_step", "log_positions", "log_slider", "step_label"], "experiments.steps"),

@@ -69,45 +69,25 @@ def _lam_of(c, scale):
     return np.linalg.eigvalsh(-(d[:, None] * c.C.toarray() * d[None, :]))[-1]
 
 
+# fmt: off
 LAM_MAX_MISTAKES = [
-    Wrong(
-        "the function returns the step limit 2 / lam_max, not lam_max",
-        "return lam_max itself",
-        build=lambda c: 2 / c.lam[-1],
-    ),
-    Wrong(
-        "the smallest eigenvalue was found, not the largest",
-        "power iteration finds the largest: z <- Q z / |Q z|",
-        build=lambda c: c.lam[0],
-    ),
-    Wrong(
-        "the sign of C is flipped: the value is -lam_max, the largest in size of M^-1/2 C M^-1/2",
-        "Q = -M^-1/2 C M^-1/2: C is negative semidefinite, so -C makes Q positive",
-        build=lambda c: -c.lam[-1],
-    ),
-    Wrong(
-        "M is left out: this is the largest eigenvalue of -C itself",
-        "Q = -M^-1/2 C M^-1/2: divide by the areas",
-        build=lambda c: _lam_of(c, 0.0),
-    ),
-    Wrong(
-        "M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2",
-        "Q = -M^-1/2 C M^-1/2: the square roots of the areas",
-        build=lambda c: _lam_of(c, -1.0),
-    ),
+    Wrong("the function returns the step limit 2 / lam_max, not lam_max", "return lam_max itself",
+          build=lambda c: 2 / c.lam[-1]),
+    Wrong("the smallest eigenvalue was found, not the largest", "power iteration finds the largest",
+          build=lambda c: c.lam[0]),
+    Wrong("the sign of C is flipped: the value is -lam_max, the largest in size of M^-1/2 C M^-1/2",
+          "Q = -M^-1/2 C M^-1/2: C is negative semidefinite", build=lambda c: -c.lam[-1]),
+    Wrong("M is left out: this is the largest eigenvalue of -C itself", "Q = -M^-1/2 C M^-1/2",
+          build=lambda c: _lam_of(c, 0.0)),
+    Wrong("M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2", "Q = -M^-1/2 C M^-1/2", build=lambda c: _lam_of(c, -1.0)),
     Wrong("M multiplies instead of dividing (-M^1/2 C M^1/2)", "Q = -M^-1/2 C M^-1/2", build=lambda c: _lam_of(c, 0.5)),
-    Wrong(
-        "this is Gershgorin's bound max_i (|C_ii| + sum_j |C_ij|) / M_ii, not the eigenvalue it bounds",
-        "iterate with Q until the Rayleigh quotient settles",
-        build=lambda c: np.max(np.asarray(abs(c.C).sum(axis=1)).ravel() / c.m),
-    ),
-    Wrong(
-        "the iteration stopped too early: the Rayleigh quotient is still below lam_max on {label}",
-        "iterate until it changes by less than 1e-12 of itself (or 20 000 products)",
-        when=lambda a, right, c: 0.5 * right < a < right * (1 - _LAM_RTOL),
-    ),
+    Wrong("this is Gershgorin's bound max_i (|C_ii| + sum_j |C_ij|) / M_ii, not the eigenvalue it bounds",
+          "iterate until the Rayleigh quotient settles", build=lambda c: np.max(abs(c.C).sum(axis=1).A1 / c.m)),
+    Wrong("the iteration stopped too early: the Rayleigh quotient is still below lam_max on {label}",
+          "iterate until it changes by less than 1e-12 of itself", when=lambda a, r, c: 0.5 * r < a < r * (1 - _LAM_RTOL)),
     Wrong("lam_max differs from the largest eigenvalue of -C e = lam M e on {label}", typical=False),
 ]
+# fmt: on
 
 _LAM_RTOL = 1e-5  # power iteration stopped at 1e-12 of change lands far closer; the mistakes lie far away
 
@@ -169,63 +149,43 @@ def explicit_loop(c, tau=None, N=None, held=True, rebuild=False, areas=-1.0, wei
     return P
 
 
-LOOP_MISTAKES = [
-    Wrong(
-        "no step was taken: the input positions come back",
-        "return the positions the loop computed",
-        build=lambda c: c.V,
-    ),
-    Wrong(
-        "the loop takes one step too few", "range(N) runs exactly N steps", build=lambda c: explicit_loop(c, N=c.N - 1)
-    ),
-    Wrong(
-        "the loop takes one step too many", "range(N) runs exactly N steps", build=lambda c: explicit_loop(c, N=c.N + 1)
-    ),
-    Wrong(
-        "the boundary moves: every vertex takes the step",
-        "update only the interior rows I",
-        build=lambda c: explicit_loop(c, held=False),
-    ),
-    Wrong(
-        "M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V",
-        "call laplacian(V, F) once, before the loop",
-        build=lambda c: explicit_loop(c, rebuild=True),
-    ),
-    Wrong(
-        "the sign of the step is flipped: the loop runs the heat flow backwards",
-        "P_I += tau M_II^-1 (C P)_I",
-        build=lambda c: explicit_loop(c, tau=-c.tau),
-    ),
-    Wrong(
-        "the loop takes half a step, tau / 2", "the step is tau itself", build=lambda c: explicit_loop(c, tau=c.tau / 2)
-    ),
-    Wrong(
-        "C P is not divided by the vertex areas: M is forgotten",
-        "divide row i of C P by M_ii",
-        build=lambda c: explicit_loop(c, areas=0.0),
-    ),
-    Wrong(
-        "C P is multiplied by the vertex areas instead of divided",
-        "divide row i of C P by M_ii",
-        build=lambda c: explicit_loop(c, areas=1.0),
-    ),
-    Wrong(
-        "the loop smooths with the uniform operator; the task asks for the cotangent one",
-        "laplacian(V, F) with its default weights",
-        build=lambda c: explicit_loop(c, weights="uniform"),
-    ),
-    Wrong(
-        "the held boundary's pull C_IB P_B is left out: only C_II P_I moves the interior",
-        "use the interior rows of C with every column: (C P)_I = C_II P_I + C_IB P_B",
-        build=lambda c: explicit_loop(c, coupled=False),
-    ),
-    Wrong(
-        "the boundary vertices moved on {label}",
-        "hold them: update only the interior rows",
-        when=lambda a, right, c: not agree(a[c.B], c.V[c.B]),
-    ),
-    Wrong("the positions after N steps differ from the loop on {label}", typical=False),
-]
+def loop_mistakes(run, own):
+    """The catalogue of a loop: the mistakes an explicit and an implicit loop share, ``run(case, **changes)``
+    building each, with the loop's ``own`` entries among them and the catch-alls last."""
+    # fmt: off
+    return [
+        Wrong("no step was taken: the input positions come back", "return the positions the loop computed",
+              build=lambda c: c.V),
+        Wrong("the loop takes one step too few", "range(N) runs exactly N steps", build=lambda c: run(c, N=c.N - 1)),
+        Wrong("the loop takes one step too many", "range(N) runs exactly N steps", build=lambda c: run(c, N=c.N + 1)),
+        Wrong("the boundary moves: every vertex is updated", "update only the interior rows I",
+              build=lambda c: run(c, held=False)),
+        Wrong("M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V",
+              "call laplacian(V, F) once, before the loop", build=lambda c: run(c, rebuild=True)),
+        Wrong("the loop takes half a step, tau / 2", "the step is tau itself", build=lambda c: run(c, tau=c.tau / 2)),
+        Wrong("the loop smooths with the uniform operator; the task asks for the cotangent one",
+              "laplacian(V, F) with its default weights", build=lambda c: run(c, weights="uniform")),
+        *own,
+        Wrong("the boundary vertices moved on {label}", "hold them: update only the interior rows",
+              when=lambda a, right, c: not agree(a[c.B], c.V[c.B])),
+        Wrong("the positions after N steps differ from the loop's on {label}", typical=False),
+    ]
+    # fmt: on
+
+
+# fmt: off
+LOOP_MISTAKES = loop_mistakes(explicit_loop, [
+    Wrong("the sign of the step is flipped: the loop runs the heat flow backwards", "P_I += tau M_II^-1 (C P)_I",
+          build=lambda c: explicit_loop(c, tau=-c.tau)),
+    Wrong("C P is not divided by the vertex areas: M is forgotten", "divide row i of C P by M_ii",
+          build=lambda c: explicit_loop(c, areas=0.0)),
+    Wrong("C P is multiplied by the vertex areas instead of divided", "divide row i of C P by M_ii",
+          build=lambda c: explicit_loop(c, areas=1.0)),
+    Wrong("the held boundary's pull C_IB P_B is left out: only C_II P_I moves the interior",
+          "(C P)_I = C_II P_I + C_IB P_B: the interior rows of C with every column",
+          build=lambda c: explicit_loop(c, coupled=False)),
+])
+# fmt: on
 
 
 @exercise(

@@ -15,7 +15,15 @@ import scipy.sparse.linalg as sla
 
 from ...lessons.laplace import laplacian
 from .catalogue import Case, Wrong, agree, judge
-from .explicit import closed_ellipsoid, eigenvalues, explicit_loop, interior_blocks, loop_answer, loop_grid
+from .explicit import (
+    closed_ellipsoid,
+    eigenvalues,
+    explicit_loop,
+    interior_blocks,
+    loop_answer,
+    loop_grid,
+    loop_mistakes,
+)
 from .meshes import placed
 from .result import case_rng, exercise
 
@@ -45,84 +53,25 @@ def implicit_loop_of(
     return P
 
 
-IMPLICIT_MISTAKES = [
-    Wrong(
-        "no step was taken: the input positions come back",
-        "return the positions the loop computed",
-        build=lambda c: c.V,
-    ),
-    Wrong(
-        "the loop takes one step too few",
-        "range(N) runs exactly N steps",
-        build=lambda c: implicit_loop_of(c, N=c.N - 1),
-    ),
-    Wrong(
-        "the loop takes one step too many",
-        "range(N) runs exactly N steps",
-        build=lambda c: implicit_loop_of(c, N=c.N + 1),
-    ),
-    Wrong(
-        "the boundary moves: the whole system (M - tau C) P' = M P is solved",
-        "solve the interior block only",
-        build=lambda c: implicit_loop_of(c, held=False),
-    ),
-    Wrong(
-        "M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V",
-        "call laplacian(V, F) once, before the loop",
-        build=lambda c: implicit_loop_of(c, rebuild=True),
-    ),
-    Wrong(
-        "the sign of tau C is flipped: (M_II + tau C_II), indefinite for large tau",
-        "M_II - tau C_II",
-        build=lambda c: implicit_loop_of(c, sign=-1.0),
-    ),
-    Wrong(
-        "the loop takes half a step, tau / 2",
-        "the step is tau itself",
-        build=lambda c: implicit_loop_of(c, tau=c.tau / 2),
-    ),
-    Wrong(
-        "M is forgotten in the matrix: (I - tau C_II)",
-        "the matrix is M_II - tau C_II",
-        build=lambda c: implicit_loop_of(c, mass=False),
-    ),
-    Wrong(
-        "M is forgotten in the matrix and on the right: (I - tau C_II) P_I' = P_I + ...",
-        "multiply (P' - P) / tau = M^-1 C P' by tau M: the matrix M_II - tau C_II, the right side M_II P_I + ...",
-        build=lambda c: implicit_loop_of(c, mass=False, rhs_mass=False),
-    ),
-    Wrong(
-        "the right-hand side holds P_I where M_II P_I belongs",
-        "the right side is M_II P_I + tau C_IB P_B",
-        build=lambda c: implicit_loop_of(c, rhs_mass=False),
-    ),
-    Wrong(
-        "the held boundary's term tau C_IB P_B is missing from the right-hand side",
-        "moving the known P_B to the right gives + tau C_IB P_B",
-        build=lambda c: implicit_loop_of(c, coupling=0.0),
-    ),
-    Wrong(
-        "the held boundary's term has the wrong sign: - tau C_IB P_B",
-        "it is + tau C_IB P_B",
-        build=lambda c: implicit_loop_of(c, coupling=-1.0),
-    ),
-    Wrong(
-        "these are explicit steps P_I + tau M_II^-1 (C P)_I, not implicit ones",
-        "evaluate the Laplacian at the new positions: solve the block system",
-        build=explicit_loop,
-    ),
-    Wrong(
-        "the loop smooths with the uniform operator; the task asks for the cotangent one",
-        "laplacian(V, F) with its default weights",
-        build=lambda c: implicit_loop_of(c, weights="uniform"),
-    ),
-    Wrong(
-        "the boundary vertices moved on {label}",
-        "hold them: solve for the interior rows only",
-        when=lambda a, right, c: not agree(a[c.B], c.V[c.B]),
-    ),
-    Wrong("the positions after N steps differ from the block system's on {label}", typical=False),
-]
+# fmt: off
+IMPLICIT_MISTAKES = loop_mistakes(implicit_loop_of, [
+    Wrong("the sign of tau C is flipped: (M_II + tau C_II), indefinite for large tau", "M_II - tau C_II",
+          build=lambda c: implicit_loop_of(c, sign=-1.0)),
+    Wrong("M is forgotten in the matrix: (I - tau C_II)", "the matrix is M_II - tau C_II",
+          build=lambda c: implicit_loop_of(c, mass=False)),
+    Wrong("M is forgotten in the matrix and on the right: (I - tau C_II) P_I' = P_I + ...",
+          "tau M (P' - P) / tau = tau C P' gives M_II - tau C_II and M_II P_I",
+          build=lambda c: implicit_loop_of(c, mass=False, rhs_mass=False)),
+    Wrong("the right-hand side holds P_I where M_II P_I belongs", "the right side is M_II P_I + tau C_IB P_B",
+          build=lambda c: implicit_loop_of(c, rhs_mass=False)),
+    Wrong("the held boundary's term tau C_IB P_B is missing from the right-hand side",
+          "moving the known P_B to the right gives + tau C_IB P_B", build=lambda c: implicit_loop_of(c, coupling=0.0)),
+    Wrong("the held boundary's term has the wrong sign: - tau C_IB P_B", "it is + tau C_IB P_B",
+          build=lambda c: implicit_loop_of(c, coupling=-1.0)),
+    Wrong("these are explicit steps P_I + tau M_II^-1 (C P)_I, not implicit ones",
+          "evaluate the Laplacian at the new positions: solve the block system", build=explicit_loop),
+])
+# fmt: on
 
 
 @exercise(

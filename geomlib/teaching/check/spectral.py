@@ -70,87 +70,53 @@ def _gram(E, c):
     return E.T @ (c.m[:, None] * E)
 
 
+def _diagonal(E, c):
+    G = _gram(E, c)
+    return np.allclose(G, np.diag(np.diag(G)), atol=1e-6 * np.abs(G).max())
+
+
+def _some_of(lam, c):
+    return np.all(np.abs(lam[:, None] - c.every[None, :]).min(axis=1) <= 1e-6 * c.every[-1])
+
+
+# fmt: off
 LAM_MISTAKES = [
-    Wrong(
-        "the sign of C is flipped: the eigenvalues are <= 0, those of M^-1/2 C M^-1/2",
-        "Q = -M^-1/2 C M^-1/2",
-        when=lambda lam, right, c: agree(np.sort(lam), np.sort(-right)),
-    ),
-    Wrong(
-        "the sign of C is flipped, and the first k of M^-1/2 C M^-1/2 are its most negative",
-        "Q = -M^-1/2 C M^-1/2, whose smallest eigenvalues are the ones near 0",
-        build=lambda c: -c.every[::-1][: c.k],
-    ),
-    Wrong(
-        "the eigenvalues are the k largest, not the k smallest",
-        "take the first k of the ascending eigenvalues, or eigsh in shift-invert mode with sigma just below 0",
-        build=lambda c: c.every[-c.k :],
-    ),
-    Wrong(
-        "the null mode is lost: lam_0 = 0 (the constant eigenvector) is missing, the values start at lam_1",
-        "keep the eigenpair of lam = 0: the reconstruction needs it",
-        build=lambda c: c.every[1 : c.k + 1],
-    ),
-    Wrong(
-        "M is left out: these are the eigenvalues of -C itself", "Q = -M^-1/2 C M^-1/2", build=lambda c: c.plain[: c.k]
-    ),
-    Wrong(
-        "M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2",
-        "Q = -M^-1/2 C M^-1/2: the square roots of the areas",
-        build=lambda c: c.inverse[: c.k],
-    ),
-    Wrong(
-        "the eigenvalues are not sorted (np.linalg.eig and eigsh return them in no particular order), so the first "
-        "k taken are not the k smallest",
-        "sort them, and the columns with them: order = np.argsort(lam)",
-        when=lambda lam, right, c: (
-            np.all(np.abs(lam[:, None] - c.every[None, :]).min(axis=1) <= 1e-6 * c.every[-1]) and not agree(lam, right)
-        ),
-    ),
-    Wrong(
-        "the eigenvalues differ from the k smallest of C e = -lam M e on {label}",
-        "Q = -M^-1/2 C M^-1/2 and a symmetric solver",
-        when=lambda lam, right, c: True,
-        typical=False,
-    ),
+    Wrong("the sign of C is flipped: the eigenvalues are <= 0, those of M^-1/2 C M^-1/2", "Q = -M^-1/2 C M^-1/2",
+          when=lambda lam, right, c: agree(np.sort(lam), np.sort(-right))),
+    Wrong("the sign of C is flipped, and the first k of M^-1/2 C M^-1/2 are its most negative",
+          "Q = -M^-1/2 C M^-1/2, whose smallest eigenvalues are the ones near 0", build=lambda c: -c.every[::-1][: c.k]),
+    Wrong("the eigenvalues are the k largest, not the k smallest", "the first k ascending, or eigsh with sigma below 0",
+          build=lambda c: c.every[-c.k :]),
+    Wrong("the null mode is lost: lam_0 = 0 (the constant eigenvector) is missing, the values start at lam_1",
+          "keep the eigenpair of lam = 0: the reconstruction needs it", build=lambda c: c.every[1 : c.k + 1]),
+    Wrong("M is left out: these are the eigenvalues of -C itself", "Q = -M^-1/2 C M^-1/2", build=lambda c: c.plain[: c.k]),
+    Wrong("M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2", "Q = -M^-1/2 C M^-1/2: the square roots of the areas",
+          build=lambda c: c.inverse[: c.k]),
+    Wrong("the eigenvalues are not sorted (np.linalg.eig and eigsh return them in no particular order), so the first "
+          "k taken are not the k smallest", "sort them, and the columns with them: order = np.argsort(lam)",
+          when=lambda lam, right, c: _some_of(lam, c) and not agree(lam, right)),
+    Wrong("the eigenvalues differ from the k smallest of C e = -lam M e on {label}", "Q = -M^-1/2 C M^-1/2 and a "
+          "symmetric solver", when=lambda lam, right, c: True, typical=False),
 ]
 
 E_MISTAKES = [
-    Wrong(
-        "E holds the eigenvectors z of Q, not transformed back",
-        "e = M^-1/2 z: E = Z / np.sqrt(m)[:, None]",
-        when=lambda a, right, c: _residual(a[1] / np.sqrt(c.m)[:, None], a[0], c),
-    ),
-    Wrong(
-        "the back-transform uses M^-1 instead of M^-1/2",
-        "e = M^-1/2 z",
-        when=lambda a, right, c: _residual(a[1] * np.sqrt(c.m)[:, None], a[0], c),
-    ),
-    Wrong(
-        "the columns of E are not eigenvectors for these lam on {label} (C E + M E diag(lam) is not 0)",
-        "E[:, i] belongs to lam[i]: keep the columns in the order of their eigenvalues",
-        when=lambda a, right, c: not _residual(a[1], a[0], c),
-        typical=False,
-    ),
-    Wrong(
-        "the eigenvectors are normalised in the plain dot product (E^T E = I), not in M (E^T M E = I)",
-        "divide each column by its M-norm, sqrt(e^T M e)",
-        when=lambda a, right, c: np.allclose(np.einsum("ij,ij->j", a[1], a[1]), 1.0, rtol=1e-6),
-    ),
-    Wrong(
-        "the eigenvectors are not M-normalised: E^T M E is diagonal but not I",
-        "divide each column by sqrt(e^T M e)",
-        when=lambda a, right, c: np.allclose(
-            _gram(a[1], c), np.diag(np.diag(_gram(a[1], c))), atol=1e-6 * np.abs(_gram(a[1], c)).max()
-        ),
-    ),
-    Wrong(
-        "E^T M E is not the identity on {label}: eigenvectors of one repeated eigenvalue are not M-orthogonal",
-        "take an orthonormal basis Z of each eigenspace of Q, as a symmetric solver returns",
-        when=lambda a, right, c: True,
-        typical=False,
-    ),
+    Wrong("E holds the eigenvectors z of Q, not transformed back", "e = M^-1/2 z: E = Z / np.sqrt(m)[:, None]",
+          when=lambda a, right, c: _residual(a[1] / np.sqrt(c.m)[:, None], a[0], c)),
+    Wrong("the back-transform uses M^-1 instead of M^-1/2", "e = M^-1/2 z",
+          when=lambda a, right, c: _residual(a[1] * np.sqrt(c.m)[:, None], a[0], c)),
+    Wrong("the columns of E are not eigenvectors for these lam on {label} (C E + M E diag(lam) is not 0)",
+          "E[:, i] belongs to lam[i]: keep the columns in the order of their eigenvalues",
+          when=lambda a, right, c: not _residual(a[1], a[0], c), typical=False),
+    Wrong("the eigenvectors are normalised in the plain dot product (E^T E = I), not in M (E^T M E = I)",
+          "divide each column by its M-norm, sqrt(e^T M e)",
+          when=lambda a, right, c: np.allclose(np.einsum("ij,ij->j", a[1], a[1]), 1.0, rtol=1e-6)),
+    Wrong("the eigenvectors are not M-normalised: E^T M E is diagonal but not I", "divide each column by "
+          "sqrt(e^T M e)", when=lambda a, right, c: _diagonal(a[1], c)),
+    Wrong("E^T M E is not the identity on {label}: eigenvectors of one repeated eigenvalue are not M-orthogonal",
+          "take an orthonormal basis Z of each eigenspace of Q, as a symmetric solver returns",
+          when=lambda a, right, c: True, typical=False),
 ]
+# fmt: on
 
 
 @exercise(
@@ -215,64 +181,31 @@ def _other_basis(c, **options):
     return E[:, : c.k] @ (E[:, : c.k].T @ (m[:, None] * c.V))
 
 
+# fmt: off
 RECONSTRUCTION_MISTAKES = [
-    Wrong(
-        "the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs",
-        "E^T M E = I, so the coefficients are E_k^T M V",
-        build=lambda c: _project(c, inner=lambda c, X: X),
-    ),
-    Wrong(
-        "V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)",
-        "c = E_k^T M V",
-        build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None]),
-    ),
-    Wrong(
-        "M multiplies the result (M E_k E_k^T V) instead of V inside the inner product",
-        "V_k = E_k (E_k^T (M V))",
-        build=lambda c: _project(c, inner=lambda c, X: X, left=True),
-    ),
-    Wrong(
-        "C stands where M belongs in the inner product",
-        "the coefficients are E_k^T M V",
-        build=lambda c: _project(c, inner=lambda c, X: c.C @ X),
-    ),
-    Wrong(
-        "the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes",
-        "E[:, :k], e_0 included, and E_k^T M V",
-        build=lambda c: _project(c, first=1, inner=lambda c, X: X),
-    ),
-    Wrong(
-        "the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin",
-        "use E[:, :k], e_0 included",
-        build=lambda c: _project(c, first=1),
-    ),
-    Wrong(
-        "k is off by one: one eigenvector too few",
-        "E[:, :k] holds e_0 .. e_{k-1}",
-        build=lambda c: _project(c, k=c.k - 1),
-    ),
-    Wrong(
-        "k is off by one: one eigenvector too many",
-        "E[:, :k] holds e_0 .. e_{k-1}",
-        build=lambda c: _project(c, k=c.k + 1),
-    ),
-    Wrong(
-        "the uniform operator (valences, weights 1) is used where the cotangent one is asked",
-        "laplacian(V, F) with its default weights",
-        build=lambda c: _other_basis(c, weights="uniform"),
-    ),
-    Wrong(
-        "the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked",
-        "laplacian(V, F) with its default area",
-        build=lambda c: _other_basis(c, area="mixed"),
-    ),
-    Wrong(
-        "the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
-        "keep every row of C: the natural boundary condition needs no rule",
-        build=_boundary_rows,
-    ),
+    Wrong("the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs",
+          "E^T M E = I, so the coefficients are E_k^T M V", build=lambda c: _project(c, inner=lambda c, X: X)),
+    Wrong("V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)", "c = E_k^T M V",
+          build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None])),
+    Wrong("M multiplies the result (M E_k E_k^T V) instead of V inside the inner product", "V_k = E_k (E_k^T (M V))",
+          build=lambda c: _project(c, inner=lambda c, X: X, left=True)),
+    Wrong("C stands where M belongs in the inner product", "the coefficients are E_k^T M V",
+          build=lambda c: _project(c, inner=lambda c, X: c.C @ X)),
+    Wrong("the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes",
+          "E[:, :k], e_0 included, and E_k^T M V", build=lambda c: _project(c, first=1, inner=lambda c, X: X)),
+    Wrong("the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin",
+          "use E[:, :k], e_0 included", build=lambda c: _project(c, first=1)),
+    Wrong("k is off by one: one eigenvector too few", "E[:, :k] holds e_0 .. e_{k-1}", build=lambda c: _project(c, k=c.k - 1)),
+    Wrong("k is off by one: one eigenvector too many", "E[:, :k] holds e_0 .. e_{k-1}", build=lambda c: _project(c, k=c.k + 1)),
+    Wrong("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
+          "laplacian(V, F) with its default weights", build=lambda c: _other_basis(c, weights="uniform")),
+    Wrong("the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked",
+          "laplacian(V, F) with its default area", build=lambda c: _other_basis(c, area="mixed")),
+    Wrong("the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
+          "keep every row of C: the natural boundary condition needs no rule", build=_boundary_rows),
     Wrong("V_k differs from the M-orthogonal projection on {label}", "V_k = E_k (E_k^T M V)", typical=False),
 ]
+# fmt: on
 
 
 def _positions(fn, c):

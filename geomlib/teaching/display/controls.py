@@ -21,17 +21,23 @@ The controls are real ipywidgets and the views real :class:`MeshView` widgets in
 one box, as the browser tests and the website expect (geomlib/teaching/display/viewer.py
 says how they find them). ``mesh_warnings(run, ...)`` gives the same read-out of
 warnings for a run outside a live cell.
+
+``live_figure(draw, controls)`` does the same for a matplotlib figure: ``draw(**values)``
+returns ``(fig, alt)`` and is called again at every move; where no widget front-end
+runs (nbgrader's feedback pages) the box is the figure's still picture.
 """
 
 import html
 import time
 import warnings
 
+import numpy as np
+
 from ...mesh.errors import MeshError, MeshWarning
 from .stills import png_base64
-from .viewer import MeshView, ViewRow, box_alt, box_still, stills_only
+from .viewer import MeshView, ViewRow, box_alt, box_still, register_still, stills_only
 
-__all__ = ["live", "Live", "mesh_warnings"]
+__all__ = ["live", "Live", "live_figure", "LiveFigure", "mesh_warnings"]
 
 
 def mesh_warnings(run, *args, **kwargs):
@@ -116,3 +122,80 @@ def live(update, controls, views, per_row=2):
     adds the MeshWarnings of the update ("⚠ ...", not on stderr) and its time.
     """
     return Live(update, controls, views, per_row)
+
+
+class LiveFigure:
+    """Controls above a matplotlib figure redrawn at every move (:func:`live_figure`); displays as that box.
+
+    Without a widget front-end (nbgrader's feedback pages, an exported page) the box is the
+    figure drawn at the controls' values, a still picture with its alt text, instead of the
+    text ``VBox(...)``.
+
+    Attributes
+    ----------
+    widget : ipywidgets.VBox, the controls' rows and the figure's Output
+    controls : dict name -> control
+    """
+
+    def __init__(self, draw, controls, per_row):
+        import ipywidgets
+
+        self.draw, self.controls = draw, dict(controls)
+        items = list(self.controls.values())
+        rows = [ipywidgets.HBox(items[k : k + per_row]) for k in range(0, len(items), per_row)]
+        figure = ipywidgets.interactive_output(self._show, self.controls)
+        self.widget = ipywidgets.VBox([*rows, figure])
+        register_still(figure, self)
+        self._drawn = None  # (values, picture, alt) of the last still
+
+    def _show(self, **values):
+        from ..notebook import show_figure
+
+        show_figure(*self.draw(**values))
+
+    def _picture(self):
+        import io
+
+        import matplotlib.pyplot as plt
+        from PIL import Image
+
+        values = {name: control.value for name, control in self.controls.items()}
+        if self._drawn is None or self._drawn[0] != values:
+            fig, alt = self.draw(**values)
+            buffer = io.BytesIO()
+            fig.savefig(buffer, format="png", bbox_inches="tight")  # framed as show_figure frames it
+            plt.close(fig)
+            picture = np.asarray(Image.open(buffer).convert("RGB"))
+            self._drawn = values, picture, " ".join(str(alt).split())
+        return self._drawn
+
+    def still(self):
+        """(h, w, 3) uint8: the figure at the controls' current values."""
+        return self._picture()[1]
+
+    def alt_text(self):
+        """The figure's alt text at the controls' current values."""
+        return self._picture()[2]
+
+    def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
+        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle["image/png"] = png_base64(self.still())
+        bundle["text/plain"] = f"Figure: {self.alt_text()}"
+        return bundle, {"image/png": {"alt": self.alt_text()}}
+
+
+def live_figure(draw, controls, per_row=3):
+    """Sliders (or any controls) above a figure that ``draw`` redraws at every move: a plot cell in one call.
+
+    Parameters
+    ----------
+    draw : callable
+        Called with every control's value as a keyword argument (its name in ``controls``); returns
+        ``(fig, alt)``, a matplotlib Figure and its alt text, as the workbook's figure functions do.
+    controls : dict name -> ipywidgets control, shown ``per_row`` to a row above the figure.
+
+    Returns
+    -------
+    LiveFigure, displayed as the box; where no widget front-end runs, as the figure's still picture.
+    """
+    return LiveFigure(draw, controls, per_row)

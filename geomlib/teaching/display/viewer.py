@@ -155,7 +155,16 @@ from .stills import (
     view_normals,
 )
 
-__all__ = ["MeshView", "ViewRow", "side_by_side", "box_still", "box_alt", "stills_only", "setup_display"]
+__all__ = [
+    "MeshView",
+    "ViewRow",
+    "side_by_side",
+    "box_still",
+    "box_alt",
+    "stills_only",
+    "register_still",
+    "setup_display",
+]
 
 #: in ``side_by_side``, a mesh whose bounding box is smaller than this fraction
 #: of the largest one is drawn enlarged to the largest one's size
@@ -763,6 +772,12 @@ class ViewRow:
 # widget model id -> the MeshView or ViewRow that made the widget (weak: a
 # view the notebook dropped is not kept alive for its picture)
 _SHOWN = weakref.WeakValueDictionary()
+
+
+def register_still(widget, shown):
+    """Let a box holding ``widget`` be drawn as ``shown.still()`` ((h, w, 3) uint8), described by
+    ``shown.alt_text()``: what :func:`box_still` and :func:`box_alt` find for it, as for a view."""
+    _SHOWN[widget.model_id] = shown
 
 
 def box_still(box):
