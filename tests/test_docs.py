@@ -67,10 +67,16 @@ COMMANDS = [
     (r"nbgrader (generate_assignment|autograde|export|generate_feedback|validate)\b", "tests/test_nbgrader.py"),
     (r"nbgrader (quickstart|release_assignment|collect|release_feedback|fetch_assignment|submit|fetch_feedback)\b", "here"),
     (r"cd geomlib-course$", "here"),
-    (r"rm -r source/ps1$", "here"),
+    (r"rm -r source/ps1 source/header\.ipynb$", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
     (r"mkdir -p source/curvature$", "here"),
-    (r"cp \.\./notebooks/", "here"),
-    (r"cat >> nbgrader_config\.py$", "here"),
+    (r"cp \.\./notebooks/0\[1-7\]", "here"),
+    (r"cat >> nbgrader_config\.py$", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
+    (r"geomlib-course autograde \. \w+ --workers \d+$", "tests/test_course.py::test_progress_shows_each_student_with_the_count_seconds_and_time_left"),
+    (r"geomlib-course report \. \w+$", "tests/test_course.py::test_the_class_report_counts_every_outcome_exactly"),
+    # the guide's one-machine trial, run as a script by the test (the students' configuration too)
+    (r"(mkdir -p (source/trial|\.\./alice|~/\.jupyter)|cd \.\./(alice|bob|geomlib-course)|cd \.\.$|cd bob$)", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
+    (r"(cp \.\./notebooks/01_|cp -r alice bob$|rm -r \.cache trial$|sed -i s/alice/bob/ )", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
+    (r"cat > (nbgrader_config\.py|~/\.jupyter/nbgrader_config\.py)$", "tests/test_course.py::test_the_guides_course_folder_and_one_machine_trial"),
 ]
 # fmt: on
 
@@ -322,6 +328,16 @@ def test_the_readme_names_every_exercise_in_its_notebooks_row():
             if cell.metadata.get("nbgrader", {}).get("solution") and grade_id in exercises:
                 graded[grade_id] = path.name
     assert named == graded
+
+
+def test_the_syllabus_gives_each_notebook_the_time_its_opening_block_states():
+    """docs/syllabus.md's table and its total: the minutes of each notebook's **Time** line."""
+    text = (ROOT / "docs" / "syllabus.md").read_text()
+    rows = re.findall(r"^\| \[(\d\d)\]\(\.\./notebooks/([^)]+)\) \|[^|]*\| (\d+) \|$", text, re.M)
+    assert [n for n, *_ in rows] == [f"{i:02d}" for i in range(8)]
+    for _, name, stated in rows:
+        assert int(stated) == _stated_minutes(ROOT / "notebooks" / name), name
+    assert f"{sum(int(m) for *_, m in rows)} minutes" in " ".join(text.split())
 
 
 def _time_lines():

@@ -110,13 +110,36 @@ def _notebook_sources():
                 yield "\n".join(line for line in lines if not line.lstrip().startswith(("%", "!")))
 
 
+def _package_sources(course):
+    """The sources of geomlib's modules outside (course False) or inside (course True) geomlib/course."""
+    for path in sorted((ROOT / "geomlib").rglob("*.py")):
+        if (path.parent.name == "course") == course:
+            yield path.read_text()
+
+
 def test_package_requires_exactly_what_geomlib_imports():
-    imported = _distributions(_imported_modules(p.read_text() for p in (ROOT / "geomlib").rglob("*.py")))
+    imported = _distributions(_imported_modules(_package_sources(course=False)))
     required = set(_requirements(_project()["dependencies"]))
     unused = sorted(required - set(imported.values()))
     assert not unused, f"[project] dependencies that geomlib never imports (move them to an extra): {unused}"
     undeclared = sorted(f"{d} (import {m})" for m, d in imported.items() if d not in required)
     assert not undeclared, f"geomlib imports these, but [project] dependencies lacks them: {undeclared}"
+
+
+def test_the_course_extra_brings_what_geomlib_course_imports_beyond_geomlib():
+    """geomlib-course (geomlib/course) runs with geomlib[course]; nothing else of geomlib needs that extra."""
+    imported = _distributions(_imported_modules(_package_sources(course=True)))
+    provided = set(_requirements(_project()["dependencies"])) | set(
+        _requirements(_project()["optional-dependencies"]["course"])
+    )
+    # SQLAlchemy comes with nbgrader, whose gradebook it is
+    nbgrader = [r for r in importlib.metadata.requires("nbgrader") or () if "extra ==" not in r]
+    provided |= {canonicalize_name(Requirement(r).name) for r in nbgrader}
+    missing = sorted(f"{d} (import {m})" for m, d in imported.items() if d not in provided)
+    assert not missing, (
+        f"geomlib/course imports these, but neither [project] nor the course extra brings them: {missing}"
+    )
+    assert _project()["scripts"]["geomlib-course"] == "geomlib.course.cli:main"
 
 
 def test_notebooks_import_nothing_the_package_does_not_require():

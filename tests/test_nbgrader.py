@@ -269,6 +269,8 @@ def test_validate_names_the_exercises_still_to_do_and_passes_a_solution(course):
     for exercise in ("uniform_laplacian", "gaussian_curvature"):
         assert f"CheckFailed: {exercise}: not written yet" in stubs.stdout
         assert f"CheckFailed: {exercise}, partial credit: not written yet" in stubs.stdout
+    # every line of the checks' messages whole: nbgrader cuts a longer line with "..."
+    assert "Reread section 2" in stubs.stdout and not re.search(r"^ *(CheckFailed|  \S).*\.\.\.$", stubs.stdout, re.M)
     solved = nbgrader(course, "validate", str(course / "submitted" / "solved" / ASSIGNMENT / f"{GRADED['05']}.ipynb"))
     assert "Success! Your notebook passes all the tests." in solved.stdout
 

@@ -156,6 +156,11 @@ def test_while_nbgrader_grades_a_failed_check_raises_its_diagnosis_and_use_still
     assert failed.value._render_traceback_() == [
         "CheckFailed: double: nothing was doubled. Hint: multiply by 2. Reread section 1."
     ]
+    # a long message in lines nbgrader validate shows whole (it cuts every line at 87 characters)
+    long = CheckFailed("double: " + "the answer is wrong in a long and careful way, " * 6)
+    lines = long._render_traceback_()
+    assert len(lines) > 1 and all(len(line) <= 80 for line in lines)
+    assert " ".join(line.strip() for line in lines) == f"CheckFailed: {long}".strip()
     assert _check_double(lambda x: 2 * x).passed
     assert use(_stub, _check_double, np.negative) is np.negative
     assert "has not passed its check yet" in capsys.readouterr().out

@@ -94,6 +94,7 @@ import inspect
 import os
 import secrets
 import sys
+import textwrap
 import threading
 import warnings
 
@@ -116,13 +117,18 @@ __all__ = [
 ]
 
 
+#: the width of the lines of a failed check's message under its grade cell
+TRACEBACK_WIDTH = 80
+
+
 class CheckFailed(AssertionError):
     """A function failed its check while nbgrader grades, or a written one under the strict test run."""
 
     def _render_traceback_(self):
         # IPython shows these lines instead of the frames: under the grade cell a reader
-        # (and nbgrader's feedback page) gets the diagnosis, not geomlib's insides
-        return [f"{type(self).__name__}: {self}"]
+        # (and nbgrader's feedback page) gets the diagnosis, not geomlib's insides; in lines
+        # short enough for `nbgrader validate`, which cuts every line at 87 characters
+        return textwrap.wrap(f"{type(self).__name__}: {self}", width=TRACEBACK_WIDTH, subsequent_indent="  ")
 
 
 class Mistake(Exception):
