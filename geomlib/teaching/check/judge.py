@@ -57,17 +57,21 @@ class Sandbox:
             stderr=subprocess.DEVNULL,
             env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
         )
-        self.refusal = None
+        self.refusal, self.callables = None, []
         send(self.process.stdin.fileno(), plan)
         self.ready = self.answer()
 
     def answer(self, timeout=CALL_TIMEOUT):
         """The sandbox's next reply; a refusal raises ``Refused``, an ended process ``Ended``."""
         fd = self.process.stdout.fileno()
-        if not select.select([fd], [], [], timeout)[0]:
-            self.process.kill()
-            raise Ended(f"took longer than {timeout} s")
-        message = receive(fd)
+        while True:
+            if not select.select([fd], [], [], timeout)[0]:
+                self.process.kill()
+                raise Ended(f"took longer than {timeout} s")
+            message = receive(fd)
+            if message is None or "callback" not in message:
+                break
+            self._call_back(message)
         if message is None or "hit" in message:
             status = self.process.wait()
             if message is not None or status == 3:
@@ -76,6 +80,15 @@ class Sandbox:
                 raise self.refusal
             raise Ended(f"ended its process (exit status {status})")
         return message
+
+    def _call_back(self, message):
+        """Answer the sandbox's call of a function the check handed the student's (judged data in, data out)."""
+        try:
+            args = [decode(a) for a in message["args"]]
+            answer = {"ok": encode(self.callables[int(message["callback"])](*args))}
+        except Exception as exc:  # noqa: BLE001 - the student's arguments may make the check's helper raise
+            answer = {"raised": type(exc).__name__, "message": str(exc)[:500]}
+        send(self.process.stdin.fileno(), answer)
 
     def close(self):
         """End the sandbox; the refusal it reported while ending, if any."""
@@ -118,7 +131,9 @@ class Remote:
     def __call__(self, *args):
         if self.box.refusal is not None:
             raise self.box.refusal
-        send(self.box.process.stdin.fileno(), {"call": self.__name__, "args": [encode(a) for a in args]})
+        self.box.callables = []
+        sent = [encode(a, self.box.callables) for a in args]
+        send(self.box.process.stdin.fileno(), {"call": self.__name__, "args": sent})
         reply = self.box.answer()
         if "raised" in reply:
             if reply["stub"]:
