@@ -68,15 +68,14 @@ def names_used(sources):
 
 
 def _library_dirs():
-    """Folders whose module files may be imported and run while armed: the standard library and
-    the numerical libraries (with geomlib, whose routines the profile fences)."""
+    """Folders whose module files may be imported and run while armed: the standard library, the
+    installed packages (a geometry library's import is refused before it runs) and geomlib, whose
+    routines the profile fences. The student's code can write no file there while armed."""
     import sysconfig
 
-    dirs = {sysconfig.get_paths()["stdlib"], sysconfig.get_paths()["platstdlib"]}
-    for name in ("numpy", "scipy", "sympy", "mpmath", "geomlib"):
-        spec = importlib.util.find_spec(name)
-        if spec is not None and spec.submodule_search_locations:
-            dirs.update(os.path.realpath(d) for d in spec.submodule_search_locations)
+    paths = sysconfig.get_paths()
+    dirs = {os.path.realpath(paths[key]) for key in ("stdlib", "platstdlib", "purelib", "platlib")}
+    dirs.update(os.path.realpath(d) for d in importlib.util.find_spec("geomlib").submodule_search_locations)
     return tuple(os.path.join(d, "") for d in dirs)
 
 
@@ -155,8 +154,8 @@ def _audit_hook(fatal, cells, libraries, makers, geometry):
         if where.startswith(makers):
             return
         if where.startswith(importer[0]) or where in importer[1:]:  # the import system, loading a module file
-            if event == "marshal.loads":
-                return
+            if event == "marshal.loads" or (event == "compile" and args[1] == "<internal>"):
+                return  # a compiled module's own start-up code (Cython's), which no Python exec can run
             path = args[1] if event == "compile" else args[0].co_filename
             if isinstance(path, str) and path.startswith(libraries) and isfile(path):
                 if event == "exec":
