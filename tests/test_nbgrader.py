@@ -132,9 +132,9 @@ def hand_in(course, student, edit=None):
 def flip_the_sign_of_C(exercise, source):
     if exercise != WRONG_EXERCISE:
         return source
-    right = "(adjacency - sparse.diags(valence))"
+    right = "    return M, C\n"
     assert right in source
-    return source.replace(right, "(sparse.diags(valence) - adjacency)")
+    return source.replace(right, "    return M, -C\n")
 
 
 @pytest.fixture(scope="module")
