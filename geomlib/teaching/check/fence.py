@@ -45,8 +45,9 @@ GEOMETRY_LIBRARIES = {
     "libigl": "libigl",
 }
 
-# a package's lazy attributes (``geomlib.laplacian``) and a module's body run by an import: no routine yet
-_LAZY = ("__getattr__", "__dir__", "<module>")
+# a package's lazy attributes (``geomlib.laplacian``), a module's body run by an import and geomlib's
+# import hook (its short module names) compute nothing of an answer
+_LAZY = ("__getattr__", "__dir__", "<module>", "find_spec", "create_module", "exec_module")
 _GEOMLIB = str(Path(__file__).resolve().parents[2]) + os.sep
 _CHECKS = str(Path(__file__).resolve().parent) + os.sep
 
@@ -132,7 +133,7 @@ class Fence:
             where = "" if caller is None else caller.f_code.co_filename
             inside = where.startswith(geomlib) and not where.startswith(checks)
             if name.startswith(geomlib) and not name.startswith(checks):
-                if inside or code.co_qualname in lazy or code in allowed:
+                if inside or code.co_name in lazy or code in allowed:
                     return
                 up = caller
                 while up is not None:  # a callback of an allowed routine (through numpy, scipy)

@@ -207,8 +207,9 @@ def judge_notebook(nb, solution=None):
     """The verdicts (module docstring), in this process: the judge's side of ``verdicts``."""
     from geomlib.teaching import check
 
-    code_cells = [c for c in nb["cells"] if c["cell_type"] == "code"]
-    imports = _text(code_cells[0]) if code_cells else ""
+    imports = [  # the notebook's import statements, wherever they are (a reference is imported where it is used)
+        _text(c) for c in nb["cells"] if c["cell_type"] == "code" and not c.get("metadata", {}).get("nbgrader")
+    ]
     cells = solution_cells(nb)
     uses = bindings(nb)
     model = solution_cells(solution) if solution else {}

@@ -39,20 +39,21 @@ from .wire import decode, encode, receive, send
 HIT_STATUS = 3
 
 
-def import_statements(source, names):
-    """The import statements of a notebook's import cell that bind one of ``names`` (magics and
-    the rest of the cell left out): what the solution cells use, without the notebook's plotting."""
-    lines = [line for line in source.splitlines() if not line.lstrip().startswith(("%", "!"))]
-    try:
-        tree = ast.parse("\n".join(lines))
-    except SyntaxError:
-        return ""
+def import_statements(sources, names):
+    """The import statements of a notebook's cells (``sources``) that bind one of ``names`` (magics
+    and everything else left out): what the solution cells use, without the notebook's plotting."""
     kept = []
-    for node in tree.body:
-        if isinstance(node, (ast.Import, ast.ImportFrom)):
-            node.names = [a for a in node.names if (a.asname or a.name).partition(".")[0] in names]
-            if node.names:
-                kept.append(ast.unparse(node))
+    for source in sources:
+        lines = [line for line in source.splitlines() if not line.lstrip().startswith(("%", "!"))]
+        try:
+            tree = ast.parse("\n".join(lines))
+        except SyntaxError:
+            continue
+        for node in tree.body:
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                node.names = [a for a in node.names if (a.asname or a.name).partition(".")[0] in names]
+                if node.names:
+                    kept.append(ast.unparse(node))
     return "\n".join(kept)
 
 
@@ -80,16 +81,17 @@ def _library_dirs():
 
 
 def _makers():
-    """Files whose code may compile and run code while armed: lambdify, namedtuple, dataclasses, and
-    ``ast.parse`` (a syntax tree only: running it takes a compile of its own)."""
+    """Files whose code may compile and run code while armed: sympy (lambdify), mpmath, namedtuple,
+    dataclasses, and ``ast.parse`` (a syntax tree only: running it takes a compile of its own)."""
     import ast
     import collections
     import dataclasses
 
     found = [ast.__file__, collections.__file__, dataclasses.__file__]
-    spec = importlib.util.find_spec("sympy")
-    if spec is not None and spec.submodule_search_locations:
-        found += [os.path.join(os.path.realpath(d), "") for d in spec.submodule_search_locations]
+    for name in ("sympy", "mpmath"):  # lambdify; mpmath's number context makes its functions at first use
+        spec = importlib.util.find_spec(name)
+        if spec is not None and spec.submodule_search_locations:
+            found += [os.path.join(os.path.realpath(d), "") for d in spec.submodule_search_locations]
     return tuple(found)
 
 
