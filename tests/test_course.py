@@ -389,3 +389,25 @@ def test_the_guides_course_folder_and_one_machine_trial(tmp_path):
     assert [p.name for p in pages] == [f"{NOTEBOOK}.html"]
     assert not (tmp_path / "bob" / "trial" / "feedback").exists()
     assert "geomlib-course/" in (ROOT / ".gitignore").read_text().splitlines()
+
+
+def test_the_syllabus_feedback_sample_is_what_the_check_says(monkeypatch):
+    """docs/syllabus.md's sample feedback: the lines a sign-flipped uniform Laplacian gets
+    under its two grade cells while nbgrader grades (the run's seed aside)."""
+    import numpy as np
+    import scipy.sparse as sparse
+
+    from geomlib import check
+
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    namespace = {"np": np, "sparse": sparse}
+    body = cc.U_DENSE.replace("{C}", "np.diag(A.sum(axis=1)) - A").strip("\n")
+    exec("def my_uniform_laplacian(V, F):\n" + textwrap.indent(body, "    "), namespace)
+    with pytest.raises(Exception) as failed:
+        check.uniform_laplacian(namespace["my_uniform_laplacian"])
+    partial = check.uniform_laplacian.partial_credit(namespace["my_uniform_laplacian"])
+    said = [*failed.value._render_traceback_(), repr(partial)]
+    (sample,) = re.findall(r"```text\n(.*?)```", (ROOT / "docs" / "syllabus.md").read_text(), flags=re.S)
+    shown = [line for line in sample.splitlines() if line and not line.startswith("check.")]
+    seedless = lambda lines: [re.sub(r"seed \d+", "seed N", line) for line in lines]
+    assert seedless(shown) == seedless(said)
