@@ -344,7 +344,7 @@ def sweep(variant=None):
         truth = W if variant == "noisy" else V_clean
         E, P = np.empty((len(taus), iterations + 1)), W
         for i, tau in enumerate(taus):
-            solve = scipy.sparse.linalg.splu((M - tau * C).tocsc()).solve
+            solve = scipy.sparse.linalg.splu((M + (1 if variant == "plus" else -1) * tau * C).tocsc()).solve
             P = P if variant == "carry" else W
             E[i, 0] = rms_reference(P, truth)
             for k in range(1, iterations + 1):
@@ -357,8 +357,9 @@ def sweep(variant=None):
                     else solve(P if variant == "rhs" else M @ P)
                 )
                 E[i, k] = rms_reference(P, truth)
-        E = E[:, 1:] if variant == "no zero column" else E.T if variant == "transposed" else E
+        E = E[:, 1:] if variant == "no zero column" else E
         i, k = np.unravel_index((np.argmax if variant == "argmax" else np.argmin)(E), E.shape)
+        E = E.T if variant == "transposed" else E
         if variant == "index":
             return i, int(k), E
         return (
@@ -381,6 +382,8 @@ WRONG_SWEEPS = {
     "argmax": "largest error",
     "one too many": "N_best is one too many",
     "index": "the index of the best step",
+    "plus": "the sign of tau C is flipped",
+    "transposed": "the table is transposed",
 }
 
 

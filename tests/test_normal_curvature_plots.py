@@ -41,8 +41,42 @@ def test_the_curvature_of_the_drawn_curve_at_the_point_is_kappa_n():
 def test_the_figure_says_what_it_shows():
     fig, alt = normal_section_figure(1.0, 0.7, 0.5, np.radians(40))
     texts = {t.get_text() for t in fig.axes[0].texts}
-    assert {"$p_u$", "$p_v$", r"$t(\varphi)$", "$n$", r"$\varphi$"} <= texts
+    assert {"$p_u$", "$p_v$", r"$t(\varphi)$", "$n$", r"$\varphi$", "$(a, 0, 0)$"} <= texts  # the point named
     assert "phi = 40 degrees" in alt and "kappa_n = 2.850" in alt and "1/kappa_n = 0.351" in alt
+    assert "perpendicular to the patch" in alt
+
+
+@pytest.mark.parametrize("degrees", [10, 40, 90, 150])
+def test_no_label_of_the_diagram_sits_on_a_line_or_on_another_label(degrees):
+    from geomlib.teaching.figures.normal_curvature_plots import screen_points
+
+    fig, _ = normal_section_figure(1.0, 0.7, 0.5, np.radians(degrees))
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    mesh = ax.collections[0]  # the light wire mesh of the ellipsoid, under everything
+    lines = list(ax.lines) + [c for c in ax.collections if hasattr(c, "_segments3d") and c is not mesh]
+    points = screen_points(ax, lines, step=0.5)
+    boxes = {t.get_text(): t.get_window_extent(renderer) for t in ax.texts}
+    assert len(boxes) == 7
+    crossed = {label: int(((points >= b.p0) & (points <= b.p1)).all(axis=1).sum()) for label, b in boxes.items()}
+    assert crossed == dict.fromkeys(boxes, 0)
+    overlapping = [(a, b) for a in boxes for b in boxes if a < b and boxes[a].overlaps(boxes[b])]
+    assert overlapping == []
+
+
+def test_the_diagram_marks_n_perpendicular_to_the_tangent_patch():
+    fig, _ = normal_section_figure(1.0, 0.7, 0.5, np.radians(40))
+    s = normal_section(1.0, 0.7, 0.5, np.radians(40))
+    marks = [np.column_stack(line.get_data_3d()) for line in fig.axes[0].lines if line.get_gid() == "right-angle"]
+    assert len(marks) == 2
+    sides = []
+    for corner in marks:
+        first, second = corner[1] - corner[0], corner[2] - corner[1]
+        assert np.allclose(np.cross(first, s["n"]), 0, atol=1e-12)  # one leg along n
+        assert abs(second @ s["n"]) < 1e-12 and np.allclose(corner[2] - s["P"], first)  # the other in the patch
+        sides.append(second / np.linalg.norm(second))
+    assert abs(sides[0] @ sides[1]) < 1e-12  # against two directions of the patch: n is normal to it
 
 
 @pytest.mark.parametrize("b, c, labels", [(0.7, 0.5, 2), (0.5, 0.5, 1), (0.5, 0.505, 1)])

@@ -100,7 +100,7 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
     -------
     H : (n,) float64
         1/length for ``weights="cotan"``. For ``"uniform"`` it is half the
-        umbrella vector (Taubin 1995): a length, not a curvature. NaN (with a
+        umbrella vector (Kobbelt et al. 1998; the weights of Taubin 1995): a length, not a curvature. NaN (with a
         MeshWarning) at vertices in no triangle of non-zero area, where M is 0.
         Meyer et al. 2003, section 3.5; Desbrun et al. 1999.
     """

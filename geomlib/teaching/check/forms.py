@@ -1,18 +1,10 @@
-"""Checks of the exercises of notebook 02: the ellipsoid's fundamental forms, and the normal curvature
-computed from whatever fundamental forms it is handed.
+"""Checks of notebook 02: the ellipsoid's fundamental forms, and kappa_n from whatever forms it is handed.
 
-``fundamental_forms``: the learner's expressions are compared by value at points drawn anew each run on
-ellipsoids with three different semi-axes (``F != 0`` there), so an unsimplified but correct expression
-passes: simplification is a matter of taste, not a mistake. The reference values come from p's derivatives
-written out with numpy here, independent of sympy.
-
-``normal_curvature``: the learner's function receives a forms function and evaluates it itself. The check
-hands it the forms of two surfaces written here: the ellipsoid, at a generic point and at (a, 0, 0), and a
-Monge patch whose ``F`` and ``f`` are both non-zero, so that a function which ignores the forms (the
-ellipsoid's kappa_n at (a, 0, 0) written in) or which drops a mixed term is told apart.
-
-sympy is imported inside the checks: it takes about a second to import, and every notebook imports
-``geomlib.check``, most of them without a symbolic exercise.
+``fundamental_forms`` compares the learner's expressions by value (an unsimplified answer passes) at points
+drawn each run on three ellipsoids with F != 0, against p's derivatives written out with numpy.
+``normal_curvature`` hands the learner's function the forms of the ellipsoid (at (a, 0, 0) and at a generic
+point) and of a Monge patch with F and f non-zero, so that a function which ignores the forms, or drops a
+mixed term, is told apart. sympy is imported inside the checks (a second to import; most notebooks need none).
 """
 
 import functools
@@ -24,7 +16,6 @@ from .result import Mistake, call, case_rng, exercise
 
 __all__ = ["fundamental_forms", "normal_curvature"]
 
-_NAMES = ("E", "F", "G", "e", "f", "g")
 _PAIR = "return the pair (I, II): I = Matrix([[E, F], [F, G]]), II = Matrix([[e, f], [f, g]])"
 
 
@@ -65,28 +56,21 @@ def _values(exprs, symbols, points):
     return vals.real
 
 
-def _derivatives(points):
-    """p_u, p_v, p_uu, p_uv, p_vv (each (k, 3)) of the ellipsoid at the points (a, b, c, u, v), written out."""
+def _reference(points):
+    """(6, k) E, F, G, e, f, g of the ellipsoid at the points (a, b, c, u, v), from p's derivatives written out,
+    and |p_u x p_v| (k,): the workbook's II takes -n = p_u x p_v / |p_u x p_v|."""
     a, b, c, u, v = points.T
     cu, su, cv, sv, zero = np.cos(u), np.sin(u), np.cos(v), np.sin(v), 0 * u
-    return (
-        np.stack([-a * su * sv, b * cu * sv, zero], axis=1),
-        np.stack([a * cu * cv, b * su * cv, -c * sv], axis=1),
-        np.stack([-a * cu * sv, -b * su * sv, zero], axis=1),
-        np.stack([-a * su * cv, b * cu * cv, zero], axis=1),
-        np.stack([-a * cu * sv, -b * su * sv, -c * cv], axis=1),
-    )
-
-
-def _reference(points):
-    """(6, k) E, F, G, e, f, g at the points, and |p_u x p_v| (k,): the workbook's II takes -n = p_u x p_v / |.|."""
-    p_u, p_v, p_uu, p_uv, p_vv = _derivatives(points)
+    p_u, p_v = np.stack([-a * su * sv, b * cu * sv, zero], 1), np.stack([a * cu * cv, b * su * cv, -c * sv], 1)
+    p_uu, p_uv = np.stack([-a * cu * sv, -b * su * sv, zero], 1), np.stack([-a * su * cv, b * cu * cv, zero], 1)
+    p_vv = np.stack([-a * cu * sv, -b * su * sv, -c * cv], 1)
     m = np.cross(p_u, p_v)
     cross = np.linalg.norm(m, axis=1)
-    minus_n = m / cross[:, None]
     dot = lambda x, y: np.einsum("ij,ij->i", x, y)  # noqa: E731
-    first = [dot(p_u, p_u), dot(p_u, p_v), dot(p_v, p_v)]
-    return np.array(first + [dot(p_uu, minus_n), dot(p_uv, minus_n), dot(p_vv, minus_n)]), cross
+    pairs = ((p_u, p_u), (p_u, p_v), (p_v, p_v), (p_uu, m), (p_uv, m), (p_vv, m))
+    return np.array([dot(x, y) for x, y in pairs]) / np.vstack(
+        [np.ones((3, len(cross))), np.tile(cross, (3, 1))]
+    ), cross
 
 
 def _forms_case(label, points):
@@ -274,10 +258,8 @@ def _right(E, F, G, e, f, g, phi):
 
 
 def _kappa_case(label, kind, a, b, c, u, v, phis):
-    coeffs = _numbers(kind, a, b, c, u, v)
-    return Case(label, a=a, b=b, c=c, u=u, v=v).but(
-        kind=kind, phis=phis, coeffs=coeffs, swapped=_numbers(kind, a, b, c, v, u)
-    )
+    coeffs, swapped = _numbers(kind, a, b, c, u, v), _numbers(kind, a, b, c, v, u)
+    return Case(label, a=a, b=b, c=c, u=u, v=v).but(kind=kind, phis=phis, coeffs=coeffs, swapped=swapped)
 
 
 def _on(c, rule):

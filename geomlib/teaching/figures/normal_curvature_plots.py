@@ -12,7 +12,14 @@ import numpy as np
 
 from ...lessons.symbolic import ellipsoid
 
-__all__ = ["normal_section", "normal_section_figure", "polar_and_dupin_figure", "kappa_turn_figure"]
+__all__ = [
+    "normal_section",
+    "normal_section_figure",
+    "place_labels",
+    "screen_points",
+    "polar_and_dupin_figure",
+    "kappa_turn_figure",
+]
 
 
 def normal_section(a, b, c, phi, u=0.0, v=np.pi / 2, samples=241):
@@ -42,18 +49,92 @@ def normal_section(a, b, c, phi, u=0.0, v=np.pi / 2, samples=241):
     return {"P": P, "p_u": p_u, "p_v": p_v, "n": n, "t": t, "w": w, "curve": curve, "kappa_n": kappa_n}
 
 
-def _arrow(ax, start, vector, label, style="-"):
+def _arrow(ax, start, vector, style="-"):
     ax.quiver(*start, *vector, color="black", linestyle=style, arrow_length_ratio=0.12, linewidth=1.3)
-    ax.text(*(start + 1.12 * vector), label, fontsize=12, ha="center", va="center")
+
+
+def screen_points(ax, lines, step=1.5):
+    """(k, 2) display coordinates of points every ``step`` pixels along the drawn ``lines`` (Line3D and
+    Line3DCollection artists of the 3D axes ``ax``, after a draw)."""
+    from mpl_toolkits.mplot3d import proj3d
+
+    polylines = []
+    for artist in lines:
+        if hasattr(artist, "get_data_3d"):
+            polylines.append(np.column_stack(artist.get_data_3d()))
+        else:
+            polylines += [np.asarray(segment, dtype=float) for segment in artist._segments3d]
+    points = []
+    for xyz in polylines:
+        x, y, _ = proj3d.proj_transform(*xyz.T, ax.get_proj())
+        screen = ax.transData.transform(np.column_stack([x, y]))
+        for p, q in zip(screen[:-1], screen[1:]):
+            count = int(np.ceil(np.linalg.norm(q - p) / step)) + 1
+            points.append(p + np.linspace(0, 1, count)[:, None] * (q - p))
+    return np.vstack(points) if points else np.zeros((0, 2))
+
+
+def place_labels(ax, labels, lines, fontsize=12, pad=4):
+    """Put each label near its 3D anchor where its box, ``pad`` pixels wider all round, touches none of
+    ``lines`` and no other label.
+
+    ``labels``: (3D anchor, text, font size or None, 3D direction or None). Candidates ring the anchor's
+    screen point in 16 directions, those nearest the given direction's (as drawn) first, the box's near
+    edge 3 to 60 pixels from it; the first free one is kept (the nearest free place), else the least
+    crowded one. The texts are ``ax.text2D`` in axes
+    coordinates, placed after a draw, so they stay where they were checked as long as the view is not
+    turned. Returns the texts.
+    """
+    from mpl_toolkits.mplot3d import proj3d
+
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    points = screen_points(ax, lines)
+    taken, texts = [], []
+    angles = np.radians(np.arange(0, 360, 22.5))
+    for anchor, label, size, toward in labels:
+        size = size or fontsize
+        x, y, _ = proj3d.proj_transform(*anchor, ax.get_proj())
+        home = ax.transData.transform((x, y))
+        order = angles
+        if toward is not None:
+            x, y, _ = proj3d.proj_transform(*(anchor + 1e-3 * np.asarray(toward)), ax.get_proj())
+            ahead = ax.transData.transform((x, y)) - home
+            order = angles[np.argsort(np.abs(np.angle(np.exp(1j * (angles - np.arctan2(ahead[1], ahead[0]))))))]
+        text = ax.text2D(0, 0, label, fontsize=size, ha="center", va="center", transform=ax.transAxes)
+        extent = text.get_window_extent(renderer)
+        half = np.array([extent.width, extent.height]) / 2 + pad
+        best = None
+        for gap in (3, 8, 15, 25, 40, 60):
+            for angle in order:
+                way = np.array([np.cos(angle), np.sin(angle)])
+                centre = home + (np.abs(way) @ half + gap) * way
+                text.set_position(ax.transAxes.inverted().transform(centre))
+                box = text.get_window_extent(renderer).padded(pad)
+                crossed = int(((points >= box.p0) & (points <= box.p1)).all(axis=1).sum())
+                crossed += 1000 * sum(box.overlaps(other) for other in taken)
+                if best is None or crossed < best[0]:
+                    best = crossed, text.get_position(), box
+                if best[0] == 0:
+                    break
+            if best[0] == 0:
+                break
+        text.set_position(best[1])
+        taken.append(best[2])
+        texts.append(text)
+    return texts
 
 
 def normal_section_figure(a, b, c, phi, u=0.0, v=np.pi / 2):
     """(fig, alt): a matplotlib 3D figure of the normal section at angle ``phi`` and its alt text.
 
     Drawn: the ellipsoid as a light wire mesh, the tangent plane (a grey patch), p_u and p_v at
-    their true lengths, t(phi) and n (unit vectors), the normal plane (a light patch), the
-    section (thick line) and its osculating circle at P (dashed, radius 1/kappa_n).
-    Series are told apart by line style and direct labels, not by colour.
+    their true lengths, t(phi) and n (unit vectors), right-angle marks between n and the tangent
+    patch, the point itself labelled with its coordinates, the normal plane (a light patch), the
+    section (thick line) and its osculating circle at P (dashed, radius 1/kappa_n). Series are
+    told apart by line style and labels, not by colour; every label sits clear of every drawn line
+    but the wire mesh (:func:`place_labels`).
     """
     import matplotlib.pyplot as plt
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -64,39 +145,54 @@ def normal_section_figure(a, b, c, phi, u=0.0, v=np.pi / 2):
     ax = fig.add_subplot(projection="3d")
     uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 25), np.linspace(0, np.pi, 13))
     X = np.stack([a * np.cos(uu) * np.sin(vv), b * np.sin(uu) * np.sin(vv), c * np.cos(vv)])
-    ax.plot_wireframe(*X, color="0.75", linewidth=0.4)
+    mesh = ax.plot_wireframe(*X, color="0.75", linewidth=0.4)
     size = 0.55 * max(a, b, c)
+    t_u = s["p_u"] / np.linalg.norm(s["p_u"])
     corners = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1)]) * size
-    tangent_patch = P + corners[:, :1] * (s["p_u"] / np.linalg.norm(s["p_u"])) + corners[:, 1:] * w
+    tangent_patch = P + corners[:, :1] * t_u + corners[:, 1:] * w
     ax.add_collection3d(Poly3DCollection([tangent_patch[:4]], facecolor="0.55", alpha=0.25))
     # the normal plane reaches from outside the surface to deep inside, so the section is seen to lie in it;
     # its dash-dot outline keeps it visible where its face, drawn light, is hidden by the wire mesh
     normal_patch = P + corners[:, :1] * t + (corners[:, 1:] - 0.4 * size) * n * 0.7
     ax.add_collection3d(Poly3DCollection([normal_patch[:4]], facecolor="0.85", alpha=0.3))
-    ax.plot(*normal_patch.T, color="black", linestyle="-.", linewidth=0.8)
-    ax.text(*normal_patch[0], r"plane of $t$ and $n$", fontsize=9, ha="right", va="top")
-    ax.plot(*s["curve"].T, color="black", linewidth=2.6)
+    drawn = ax.plot(*normal_patch.T, color="black", linestyle="-.", linewidth=0.8)
+    drawn += ax.plot(*s["curve"].T, color="black", linewidth=2.6)
     k = s["kappa_n"]
     angle = np.linspace(0, 2 * np.pi, 181)[:, None]
     circle = P - n / k + (np.cos(angle) * n + np.sin(angle) * t) / k
-    ax.plot(*circle.T, color="black", linestyle="--", linewidth=1.0)
-    for vec, label in ((s["p_u"], "$p_u$"), (s["p_v"], "$p_v$"), (t, r"$t(\varphi)$"), (0.8 * n, "$n$")):
-        _arrow(ax, P, vec, label)
+    drawn += ax.plot(*circle.T, color="black", linestyle="--", linewidth=1.0)
+    # n is perpendicular to the tangent patch: a right-angle mark against each of its two directions
+    mark = 0.2 * size
+    for side in (t_u, w):
+        corner = np.array([P + mark * side, P + mark * (side + n), P + mark * n])
+        drawn += ax.plot(*corner.T, color="black", linewidth=0.9, gid="right-angle")
+    arrows = [(s["p_u"], "$p_u$"), (s["p_v"], "$p_v$"), (t, r"$t(\varphi)$"), (0.8 * n, "$n$")]
+    for vec, _ in arrows:
+        _arrow(ax, P, vec)
     arc = np.linspace(0, phi, 30)[:, None]
-    t_u = s["p_u"] / np.linalg.norm(s["p_u"])
-    ax.plot(*(P + 0.35 * (np.cos(arc) * t_u + np.sin(arc) * w)).T, color="black", linewidth=1.0)
-    mid = P + 0.45 * (np.cos(phi / 2) * t_u + np.sin(phi / 2) * w)
-    ax.text(*mid, r"$\varphi$", fontsize=12, ha="center", va="center")
+    drawn += ax.plot(*(P + 0.55 * (np.cos(arc) * t_u + np.sin(arc) * w)).T, color="black", linewidth=1.0)
+    drawn += ax.plot(*P[:, None], "o", color="black", markersize=4)
     ax.set_box_aspect((a, b, c))
     ax.view_init(elev=28, azim=35)  # both planes seen from their face for most phi (edge-on near 145 degrees)
     ax.set_axis_off()
     ax.set_title(r"the normal section at angle $\varphi$ (thick); dashed: circle of radius $1/\kappa_n$", fontsize=10)
+    point = "$(a, 0, 0)$" if np.allclose(P, (a, 0.0, 0.0)) else f"$({P[0]:.2f}, {P[1]:.2f}, {P[2]:.2f})$"
+    labels = [(P + vec, label, None, vec) for vec, label in arrows]  # beyond the tips
+    half = np.cos(phi / 2) * t_u + np.sin(phi / 2) * w
+    labels += [
+        (P + 0.55 * half, r"$\varphi$", None, half),
+        (P, point, None, -half),
+    ]  # in the angle; the point's opposite
+    labels.append((normal_patch[0], r"plane of $t$ and $n$", 9, None))
+    arrow_lines = [c for c in ax.collections if c is not mesh and hasattr(c, "_segments3d")]
+    place_labels(ax, labels, drawn + arrow_lines)  # clear of every line but the light wire mesh
     degrees = np.degrees(phi)
     alt = (
         f"A 3D sketch of the ellipsoid with semi-axes a = {a:g}, b = {b:g}, c = {c:g}, drawn as a light wire mesh. "
         f"At the point ({P[0]:.2f}, {P[1]:.2f}, {P[2]:.2f}) a grey patch of the tangent plane carries the arrows "
         f"p_u (length {np.linalg.norm(s['p_u']):.2f}) and p_v (length {np.linalg.norm(s['p_v']):.2f}) and the unit "
-        f"tangent t at phi = {degrees:.0f} degrees from p_u; the arrow n is the outward normal. The plane of n and t "
+        f"tangent t at phi = {degrees:.0f} degrees from p_u; the arrow n is the outward normal, right-angle marks "
+        f"showing it perpendicular to the patch. The plane of n and t "
         f"(a light patch with a dash-dot outline) cuts the ellipsoid in the thick curve, the normal section; the dashed circle touching it at the point has "
         f"radius 1/kappa_n = {1 / k:.3f}, the curvature of the section there being kappa_n = {k:.3f} per length unit."
     )
