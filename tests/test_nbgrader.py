@@ -260,6 +260,8 @@ def test_feedback_pages_show_a_picture_for_every_view_and_the_diagnosis(course, 
         assert (DIAGNOSIS in page) == (student == "one_mistake" and name == GRADED["01"])
         if student == "stubs":
             assert page.count("not written yet") >= 4  # each exercise's two grade cells
+        # the model answer the release hid, put back: its rubric and its prose, not only numbers
+        assert "Rubric (" in page and "Model answer" in page, name
 
 
 @pytest.mark.slow
