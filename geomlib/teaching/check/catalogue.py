@@ -111,8 +111,11 @@ class Case:
 
     @property
     def n(self):
-        """The number of vertices (rows of the first input, or a fact ``n``)."""
-        return self.facts.get("n", len(next(iter(self.inputs.values()))))
+        """The number of vertices (a fact ``n``, else the rows of the first input, a sparse matrix too)."""
+        if "n" in self.facts:
+            return self.facts["n"]
+        first = next(iter(self.inputs.values()))
+        return first.shape[0] if hasattr(first, "shape") else len(first)
 
     def but(self, **facts):
         """This case with more facts (``where=`` restricts :func:`agree` to those entries)."""

@@ -125,6 +125,11 @@ C_MISTAKES = [
     ),
     Wrong("tan is used instead of cot", "cot theta = cos theta / sin theta = 1 / tan theta", build=lambda c: _tan(c)),
     Wrong(
+        "the angles are in degrees where np.tan expects radians",
+        "np.arccos returns radians: 1 / np.tan(theta) as it is, or the law of cosines over 4 A",
+        build=lambda c: _assemble(c, 0.5 / np.tan(np.degrees(np.arctan2(1.0, c.cot)))),
+    ),
+    Wrong(
         "boundary edges are left out: an edge with one triangle gets no weight",
         "a boundary edge gets 1/2 cot of the one angle opposite it (the natural boundary condition)",
         build=lambda c: _boundary(c, 0.0),

@@ -269,6 +269,11 @@ def _on(c, rule):
 
 KAPPA_MISTAKES = [
     Wrong(
+        "kappa_n is about 0 at every angle: a guard on the denominator swamps I(t, t) (1e10 where 1e-10 was meant?)",
+        "divide by I(t, t) itself; with the unit tangent t(phi) it is 1, so no guard is needed",
+        when=lambda kappa, right, c: np.abs(kappa).max() <= 1e-6 * np.abs(right).max(),
+    ),
+    Wrong(
         "the function does not use the forms it receives: it gives the ellipsoid's kappa_n at (a, 0, 0) everywhere",
         "call forms(a, b, c, u, v) with sympy symbols, substitute the numbers, and build kappa_n from its I and II",
         build=lambda c: c.a * np.cos(c.phis) ** 2 / c.b**2 + c.a * np.sin(c.phis) ** 2 / c.c**2,

@@ -176,6 +176,12 @@ def _boundary_rows(c):
     return _project(c, E=E)
 
 
+def _eig_rows(c):
+    lam, U = np.linalg.eig(-c.C.toarray())
+    U = U.real[np.argsort(lam.real)][:, : c.k]
+    return U @ (U.T @ c.V)
+
+
 def _other_basis(c, **options):
     m, E = _basis_of(c.V, c.F, **options)
     return E[:, : c.k] @ (E[:, : c.k].T @ (m[:, None] * c.V))
@@ -203,6 +209,9 @@ RECONSTRUCTION_MISTAKES = [
           "laplacian(V, F) with its default area", build=lambda c: _other_basis(c, area="mixed")),
     Wrong("the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
           "keep every row of C: the natural boundary condition needs no rule", build=_boundary_rows),
+    Wrong("two mistakes: M is left out (the eigenvectors of -C alone), and the rows of the eigenvector matrix are "
+          "sorted and taken where its columns are the eigenvectors", "E[:, order] and E[:, :k] of C e = -lam M e",
+          build=lambda c: _eig_rows(c)),
     Wrong("V_k differs from the M-orthogonal projection on {label}", "V_k = E_k (E_k^T M V)", typical=False),
 ]
 # fmt: on

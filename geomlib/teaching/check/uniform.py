@@ -86,6 +86,12 @@ C_MISTAKES = [
         build=lambda c: c.C_cot,
     ),
     Wrong(
+        "C holds diag(1/valence), the inverse of M, not the weights: the factors of M^-1 C handed in the wrong slots",
+        "return M, C with M = diag(valence) and " + _C_RULE,
+        build=lambda c: np.diag(1 / c.valence),
+    ),
+    Wrong("(M, C) are swapped: C holds diag(valence)", "end with `return M, C`: M first", build=lambda c: c.M),
+    Wrong(
         "C is not symmetric on {label}", "set both C_ij and C_ji for every edge", when=lambda C, _, c: not agree(C, C.T)
     ),
     Wrong("C differs from the uniform Laplacian on {label}", _C_RULE, typical=False),
@@ -140,6 +146,21 @@ def same_K(K, K_ref, case):
     return bool(np.all(both_nan | near))
 
 
+def _index_order_sums(c):
+    """2 pi - the angles at each vertex between its neighbours in index order, the last to the first."""
+    ring = [set() for _ in range(len(c.V))]
+    for i, j, k in c.F:
+        ring[i] |= {j, k}
+        ring[j] |= {k, i}
+        ring[k] |= {i, j}
+    total = np.zeros(len(c.V))
+    for i, around in enumerate(ring):
+        e = c.V[sorted(around)] - c.V[i]
+        e /= np.linalg.norm(e, axis=1, keepdims=True)
+        total[i] = np.arccos(np.clip(np.einsum("ij,ij->i", e, np.roll(e, -1, axis=0)), -1, 1)).sum()
+    return 2 * np.pi - total
+
+
 K_MISTAKES = [
     Wrong(
         "the sign of the deficit is flipped (sum of angles - 2 pi)",
@@ -156,6 +177,12 @@ K_MISTAKES = [
         "the deficit is not divided by the vertex area (integrated, not pointwise, K)",
         "divide 2 pi - sum of angles by A_i",
         build=lambda c: c.deficit,
+    ),
+    Wrong(
+        "the angles are taken between neighbours in index order, not in the ring order around the vertex: two "
+        "neighbours next to each other in a sorted list need not share a triangle with it",
+        "sum the angles of the triangles at i, one per face (each face gives its corner angle at i)",
+        build=lambda c: _index_order_sums(c) / c.A,
     ),
     *(
         Wrong(area.diagnosis, area.hint, build=lambda c, area=area: c.deficit / area.build(c))
