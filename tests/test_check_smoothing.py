@@ -104,6 +104,7 @@ def explicit(
     weights="cotan",
     coupled=True,
     refuse=True,
+    block=True,
     in_place=False,
     extra=0,
     scale=1.0,
@@ -113,8 +114,9 @@ def explicit(
     I, B = split(V, F) if held else (np.arange(len(V)), [])
     M, C = laplacian(V, F, weights=weights)
     m_I, C_I = M.diagonal()[I], C.tocsr()[I]
-    d = 1 / np.sqrt(m_I)
-    if refuse and tau >= 2 / np.linalg.eigvalsh(-(d[:, None] * C_I[:, I].toarray() * d))[-1]:
+    J = I if block else np.arange(len(V))  # the limit's rows and columns: the interior block, or the whole pair
+    d = 1 / np.sqrt(M.diagonal()[J])
+    if refuse and tau >= 2 / np.linalg.eigvalsh(-(d[:, None] * C.toarray()[np.ix_(J, J)] * d))[-1]:
         raise ValueError("past the limit")
     P = V if in_place else V.copy()
     for _ in range(N + extra):
@@ -154,6 +156,7 @@ LOOP_LEARNERS = {
     "pull C_IB P_B is left out": lambda V, F, tau, N: explicit(V, F, tau, N, coupled=False),
     "changed its input V in place": lambda V, F, tau, N: explicit(V, F, tau, N, in_place=True),
     "ran instead of being refused": lambda V, F, tau, N: explicit(V, F, tau, N, refuse=False),
+    "the whole pair (M, C), not from its interior block": lambda V, F, tau, N: explicit(V, F, tau, N, block=False),
 }
 
 

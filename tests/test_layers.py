@@ -195,7 +195,9 @@ def test_importing_sets_up_no_display_and_setup_display_does(tmp_path):
         capture_output=True,
         text=True,
         timeout=300,
-        env=dict(os.environ, MPLBACKEND="agg", IPYTHONDIR=str(tmp_path)),  # the shell's history stays out of the checkout
+        env=dict(
+            os.environ, MPLBACKEND="agg", IPYTHONDIR=str(tmp_path)
+        ),  # the shell's history stays out of the checkout
         cwd=PACKAGE.parent,
     )
     assert done.returncode == 0, done.stderr[-3000:]

@@ -2,11 +2,9 @@
 
 ``cotangent_matrix`` hands the learner's function the per-face edge lengths ``l`` (m, 3) and ``F`` of an
 irregular tetrahedron (closed, no right angle), an irregular bipyramid (closed, obtuse triangles) and a
-jittered 4 x 4 grid (open: boundary edges with one triangle), each placed anew every run
-(``meshes.placed``). Its typical mistakes are rebuilt from the right per-corner cotangents and Heron's
-areas: an edge given the angle at one of its own ends, Heron without its 1/4 or with the perimeter, the
-law of cosines without squares, cos or tan for cot, the 1/2 missing, the sign, the boundary rule.
-``mixed_areas`` names its mistakes from ``check.area_mistakes``, in the words every area check uses.
+jittered 4 x 4 grid (open: boundary edges with one triangle), placed anew every run; its typical mistakes are
+rebuilt from the right per-corner cotangents and Heron's areas. ``mixed_areas`` names its mistakes from
+``check.area_mistakes``, in the words every area check uses.
 """
 
 import numpy as np
@@ -15,14 +13,24 @@ from ...lessons.laplace import cotangent_matrix as geomlib_cotangent_matrix
 from ...lessons.laplace import edge_lengths
 from ...mesh.topology import boundary_edges
 from .area_mistakes import AREA_MISTAKES, RIGHT_AREAS
-from .catalogue import Case, Wrong, judge, run, vector
-from .meshes import irregular_bipyramid, irregular_tetrahedron, jittered_grid_4x4, obtuse_triangle, placed
+from .catalogue import Case, Wrong, judge, mesh_cases, run, vector
+from .meshes import irregular_bipyramid, irregular_tetrahedron, jittered_grid_4x4, obtuse_triangle
 from .result import Mistake, case_rng, exercise
 
 __all__ = ["cotangent_matrix", "mixed_areas"]
 
 NEXT, PREV = [1, 2, 0], [2, 0, 1]  # the corners j, k that follow corner i
 _RULE = "corner i of each face adds 1/2 cot(theta_i) to C_jk and C_kj, (j, k) the edge opposite it"
+_ENDS = (
+    "each edge gets the cotangent of an angle at one of its own ends, not of the corner opposite it (the lengths or "
+    "the corners read in the wrong order)",
+    "l[f, i] is the edge opposite corner i; cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A) goes to that edge",
+)
+_MESHES = (
+    ("an irregular tetrahedron", irregular_tetrahedron()),
+    ("an irregular bipyramid", irregular_bipyramid()),
+    ("a jittered 4 x 4 grid", jittered_grid_4x4()),
+)
 
 
 def _assemble(c, w, both=True, diagonal=True):
@@ -70,12 +78,7 @@ def cotangent_case(label, V, F):
 
 
 def cotangent_cases(rng):
-    meshes = (
-        ("an irregular tetrahedron", irregular_tetrahedron()),
-        ("an irregular bipyramid", irregular_bipyramid()),
-        ("a jittered 4 x 4 grid", jittered_grid_4x4()),
-    )
-    return [cotangent_case(label, *placed(V, F, rng)) for label, (V, F) in meshes]
+    return [cotangent_case(c.label, c.V, c.F) for c in mesh_cases(_MESHES, rng)]
 
 
 C_MISTAKES = [
@@ -101,18 +104,7 @@ C_MISTAKES = [
         "set C_ii = -sum of C_ij over the neighbours j of i",
         build=lambda c: c.C - np.diag(np.diag(c.C)),
     ),
-    Wrong(
-        "each edge gets the cotangent of an angle at one of its own ends, not of the corner opposite it (the "
-        "lengths or the corners read in the wrong order)",
-        "l[f, i] is the edge opposite corner i; cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A) goes to that edge",
-        build=lambda c: _assemble(c, 0.5 * c.cot[:, NEXT]),
-    ),
-    Wrong(
-        "each edge gets the cotangent of an angle at one of its own ends, not of the corner opposite it (the "
-        "lengths or the corners read in the wrong order)",
-        "l[f, i] is the edge opposite corner i; cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A) goes to that edge",
-        build=lambda c: _assemble(c, 0.5 * c.cot[:, PREV]),
-    ),
+    *(Wrong(*_ENDS, build=lambda c, end=end: _assemble(c, 0.5 * c.cot[:, end])) for end in (NEXT, PREV)),
     Wrong(
         "the law of cosines is written with the lengths, not their squares",
         "cos theta_i = (l_j^2 + l_k^2 - l_i^2) / (2 l_j l_k), so cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)",
@@ -197,13 +189,7 @@ def cotangent_matrix(fn):
 
 
 def areas_cases(rng):
-    meshes = (
-        ("one obtuse triangle", obtuse_triangle()),
-        ("an irregular tetrahedron", irregular_tetrahedron()),
-        ("an irregular bipyramid", irregular_bipyramid()),
-        ("a jittered 4 x 4 grid", jittered_grid_4x4()),
-    )
-    return [Case(label, V=V, F=F) for label, (V, F) in ((lb, placed(V, F, rng)) for lb, (V, F) in meshes)]
+    return mesh_cases((("one obtuse triangle", obtuse_triangle()), *_MESHES), rng)
 
 
 def _per_vertex(out, n):
