@@ -23,6 +23,7 @@ from geomlib.teaching.check.result import reveal
 SHORTCUTS = {
     "uniform_laplacian": lambda V, F: geomlib.laplacian(V, F, weights="uniform"),
     "gaussian_curvature": lambda V, F: geomlib.gaussian_curvature(V, F),
+    "mean_curvature": lambda V, F, M, C: geomlib.mean_curvature(V, F, "uniform", signed=True, boundary="nan"),
     "cotangent_matrix": lambda l, F: intrinsic_cotangent_matrix(l, F),
     "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
     "spectral_reconstruction": lambda V, F, k: geomlib.spectral_reconstruction(V, F, k, cache=False),
