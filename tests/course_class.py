@@ -164,7 +164,8 @@ return Mass, Lap
 """
 
 U_FORBIDDEN = """
-return reference_uniform_laplacian(V, F)
+from geomlib.lessons.laplace import uniform_laplacian
+return uniform_laplacian(V, F)
 """
 
 # ---------------------------------------------------------------------------

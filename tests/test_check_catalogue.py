@@ -100,6 +100,14 @@ def test_a_mistake_is_named_only_when_it_matches_on_every_case_and_is_wrong_on_o
     assert first_mistake([Wrong("same", build=lambda c: c.x)], cases, half, lambda c: c.x).diagnosis != "same"
 
 
+def test_a_case_counts_its_vertices_from_a_sparse_first_input_or_a_fact():
+    import scipy.sparse as sp
+
+    assert Case("sparse", M=sp.identity(7, format="csr"), k=3).n == 7  # len() of a sparse matrix raises
+    assert Case("dense", V=np.zeros((5, 3))).n == 5
+    assert Case("told", M=sp.identity(7, format="csr")).but(n=4).n == 4
+
+
 def test_agree_is_relative_to_the_scale_and_reads_where():
     assert agree(1e6 * np.ones(3) + 0.5, 1e6 * np.ones(3))
     assert not agree(np.ones(3) + 1e-3, np.ones(3))

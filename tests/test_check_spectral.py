@@ -157,6 +157,13 @@ def projection(
     return m[:, None] * (E @ (E.T @ V)) if inner == "left" else E @ c
 
 
+def eig_rows(V, F, k):
+    """np.linalg.eig of -C alone, its eigenvector matrix sorted by rows: M left out, rows for columns."""
+    w, U = np.linalg.eig(-laplacian(V, F)[1].toarray())
+    basis = U.real[np.argsort(w.real)][:, :k]
+    return basis @ (basis.T @ V)
+
+
 RECONSTRUCTION_LEARNERS = {
     "the plain dot product E_k^T V": lambda V, F, k: projection(V, F, k, inner="plain"),
     "V is divided by the vertex areas": lambda V, F, k: projection(V, F, k, inner="inverse"),
@@ -170,6 +177,7 @@ RECONSTRUCTION_LEARNERS = {
     "the mixed (Voronoi) vertex areas": lambda V, F, k: projection(V, F, k, area="mixed"),
     "the rows of the boundary vertices are zeroed": lambda V, F, k: projection(V, F, k, zero_boundary=True),
     "(M, C) are swapped": lambda V, F, k: projection(V, F, k, swap=True),
+    "the rows of the eigenvector matrix are sorted": eig_rows,
     "differs from the M-orthogonal projection": lambda V, F, k: 1.01 * projection(V, F, k),
 }
 

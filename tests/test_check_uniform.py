@@ -367,3 +367,97 @@ def test_K_stub_and_strict_mode(monkeypatch):
     assert not check.gaussian_curvature(stub).passed  # a stub never raises
     with pytest.raises(CheckFailed, match="sign of the deficit"):
         check.gaussian_curvature(K_MISTAKES["sign"][0])
+
+
+# ---------------------------------------------------------------- the signed mean curvature H, from (M, C)
+def learner_H(V, F, M, C, sign=1.0, half=0.5, inverse=True, normalise=True, weights="area", rule="nan"):
+    """A learner's H = -1/2 <M^-1 C x, n>, written independently of the check, with knobs for the mistakes."""
+    CX = C @ V
+    DX = CX / M.diagonal()[:, None] if inverse else CX
+    N = np.zeros_like(V)
+    for f in F:
+        a, b, c = V[f]
+        n = np.cross(b - a, c - a)
+        N[f] += n if weights == "area" else n / np.linalg.norm(n)
+    if normalise:
+        N /= np.linalg.norm(N, axis=1)[:, None]
+    H = -sign * half * (DX * N).sum(axis=1)
+    if rule == "nan":
+        H[boundary(V, F)] = np.nan
+    return H
+
+
+def H_dense(V, F, M, C):
+    """Correct variant: dense matrices and a solve instead of a division."""
+    DX = np.linalg.solve(M.toarray(), C.toarray() @ V)
+    N = np.zeros_like(V)
+    for k in range(3):
+        np.add.at(N, F[:, k], np.cross(V[F[:, (k + 1) % 3]] - V[F[:, k]], V[F[:, (k + 2) % 3]] - V[F[:, k]]))
+    H = -0.5 * np.einsum("ij,ij->i", DX, N / np.linalg.norm(N, axis=1, keepdims=True))
+    return np.where(boundary(V, F), np.nan, H).tolist()  # a list is read as the vector it holds
+
+
+def H_sparse_solve(V, F, M, C):
+    """Correct variant: scipy.sparse.linalg.spsolve, the normals from the faces' corners in a rotated order."""
+    import scipy.sparse.linalg as spla
+
+    DX = spla.spsolve(M.tocsc(), C @ V)
+    i, j, k = F[:, 1], F[:, 2], F[:, 0]
+    n2 = np.cross(V[j] - V[i], V[k] - V[i])
+    N = sum(
+        sparse.coo_matrix((n2[:, d], (c, np.full(len(F), d))), shape=(len(V), 3)) for c in (i, j, k) for d in range(3)
+    )
+    N = N.toarray() / np.linalg.norm(N.toarray(), axis=1)[:, None]
+    H = -0.5 * (DX * N).sum(axis=1)
+    H[boundary(V, F)] = np.nan
+    return H
+
+
+H_MISTAKES = {
+    "inward normals": (lambda V, F, M, C: learner_H(V, F[:, ::-1], M, C), "H has the wrong sign"),
+    "no minus sign": (lambda V, F, M, C: learner_H(V, F, M, C, sign=-1.0), "H has the wrong sign"),
+    "no 1/2": (lambda V, F, M, C: learner_H(V, F, M, C, half=1.0), "the factor 1/2 is missing"),
+    "no M^-1": (lambda V, F, M, C: learner_H(V, F, M, C, inverse=False), "M^-1 is missing"),
+    "raw normal sums": (lambda V, F, M, C: learner_H(V, F, M, C, normalise=False), "the normals are not normalised"),
+    "unit face normals": (
+        lambda V, F, M, C: learner_H(V, F, M, C, weights="unit"),
+        "the normals average the unit face normals",
+    ),
+    "no boundary rule": (lambda V, F, M, C: learner_H(V, F, M, C, rule="formula"), "applied at boundary vertices"),
+    "boundary zero": (
+        lambda V, F, M, C: np.nan_to_num(learner_H(V, F, M, C)),
+        "boundary vertices have a value (the wrong boundary rule)",
+    ),
+}
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("entry", built(catalogues.H_MISTAKES + catalogues.H_BOUNDARY_MISTAKES), ids=repr)
+def test_every_wrong_H_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    cases = catalogues.mean_cases(np.random.default_rng(seed))
+    result = check.mean_curvature(replaying(cases, entry.build), seed=seed)
+    assert_diagnosed(result, entry.diagnosis)
+    assert result.partial
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("fn", [learner_H, H_dense, H_sparse_solve])
+def test_H_accepts_correct_variants(fn, seed):
+    result = check.mean_curvature(fn, seed=seed)
+    assert result.passed and "bump" in result.message and "cotangent (M, C)" in result.message, result.message
+
+
+@pytest.mark.parametrize("name", H_MISTAKES)
+def test_H_diagnoses(name):
+    fn, phrase = H_MISTAKES[name]
+    result = check.mean_curvature(fn)
+    assert_diagnosed(result, phrase)
+    assert result.partial
+
+
+def test_H_unnamed_mistake_and_wrong_shape_earn_no_partial_credit():
+    scaled = check.mean_curvature(lambda V, F, M, C: 1.3 * learner_H(V, F, M, C))
+    assert_diagnosed(scaled, "H differs from -1/2 <M^-1 C x, n> at interior vertices")
+    vectors = check.mean_curvature(lambda V, F, M, C: -0.5 * (C @ V) / M.diagonal()[:, None])
+    assert_diagnosed(vectors, "expected (")
+    assert not scaled.partial and not vectors.partial

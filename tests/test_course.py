@@ -191,6 +191,44 @@ def postgres():
     shutil.rmtree(data, ignore_errors=True)
 
 
+def test_a_checks_message_gives_its_diagnosis_the_same_for_every_student():
+    from geomlib.course.report import diagnosis_of
+
+    message = "uniform_laplacian: the sign of C is flipped. Hint: C_ii = -valence. Reread section 2."
+    assert diagnosis_of("uniform_laplacian", ("CheckFailed", message)) == cc.SIGN
+    seeded = "add_noise: the noise is not scaled (seed 81723). Hint: h. Reread section 1."
+    assert diagnosis_of("add_noise", ("CheckFailed", seeded)) == "the noise is not scaled"
+    partial = "uniform_laplacian, partial credit: not written yet: the function raises NotImplementedError."
+    assert diagnosis_of("uniform_laplacian", ("CheckFailed", partial)) == "not written yet"
+    assert diagnosis_of("x", ("NameError", "name 'my_x' is not defined")) == (
+        "the grade cell raised NameError: name 'my_x' is not defined"
+    )
+    assert diagnosis_of("x", None) == ""
+
+
+def test_progress_line_says_done_of_total_seconds_and_time_left():
+    line = parallel.progress_line(3, 20, "alice", 5.24, 12.0)
+    assert line == "[ 3/20] alice graded in 5.2 s; 12 s elapsed, about 68 s left"
+    assert parallel.progress_line(20, 20, "bob", 4.0, 80.0, ok=False).endswith(
+        "FAILED in 4.0 s; 80 s elapsed, about 0 s left"
+    )
+
+
+def test_the_course_is_read_as_nbgrader_reads_it_in_its_folder(tmp_path):
+    from geomlib.course.coursedir import load_course
+
+    (tmp_path / "nbgrader_config.py").write_text(
+        "c = get_config()\nc.CourseDirectory.course_id = 'geo'\nc.CourseDirectory.db_url = 'sqlite:///grades.db'\n"
+    )
+    for student in ("bob", "alice"):
+        (tmp_path / "submitted" / student / "hw1").mkdir(parents=True)
+    (tmp_path / "submitted" / "carol" / "hw2").mkdir(parents=True)
+    course = load_course(tmp_path)
+    assert course.course_id == "geo" and course.root == tmp_path.resolve()
+    assert course.sqlite_file == tmp_path.resolve() / "grades.db"  # relative to the course folder
+    assert course.submitted_students("hw1") == ["alice", "bob"]
+
+
 @pytest.mark.slow
 def test_the_class_has_twenty_students_or_more_and_every_kind_of_answer():
     assert len(cc.CLASS) >= 20
@@ -351,3 +389,25 @@ def test_the_guides_course_folder_and_one_machine_trial(tmp_path):
     assert [p.name for p in pages] == [f"{NOTEBOOK}.html"]
     assert not (tmp_path / "bob" / "trial" / "feedback").exists()
     assert "geomlib-course/" in (ROOT / ".gitignore").read_text().splitlines()
+
+
+def test_the_syllabus_feedback_sample_is_what_the_check_says(monkeypatch):
+    """docs/syllabus.md's sample feedback: the lines a sign-flipped uniform Laplacian gets
+    under its two grade cells while nbgrader grades (the run's seed aside)."""
+    import numpy as np
+    import scipy.sparse as sparse
+
+    from geomlib import check
+
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    namespace = {"np": np, "sparse": sparse}
+    body = cc.U_DENSE.replace("{C}", "np.diag(A.sum(axis=1)) - A").strip("\n")
+    exec("def my_uniform_laplacian(V, F):\n" + textwrap.indent(body, "    "), namespace)
+    with pytest.raises(Exception) as failed:
+        check.uniform_laplacian(namespace["my_uniform_laplacian"])
+    partial = check.uniform_laplacian.partial_credit(namespace["my_uniform_laplacian"])
+    said = [*failed.value._render_traceback_(), repr(partial)]
+    (sample,) = re.findall(r"```text\n(.*?)```", (ROOT / "docs" / "syllabus.md").read_text(), flags=re.S)
+    shown = [line for line in sample.splitlines() if line and not line.startswith("check.")]
+    seedless = lambda lines: [re.sub(r"seed \d+", "seed N", line) for line in lines]
+    assert seedless(shown) == seedless(said)

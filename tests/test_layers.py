@@ -188,14 +188,16 @@ DISPLAY_PROBE = textwrap.dedent("""
 """)
 
 
-def test_importing_sets_up_no_display_and_setup_display_does():
+def test_importing_sets_up_no_display_and_setup_display_does(tmp_path):
     names = [module_name(p) for p in MODULES if layer(module_name(p)) != "course"]
     done = subprocess.run(
         [sys.executable, "-c", DISPLAY_PROBE, *names],
         capture_output=True,
         text=True,
         timeout=300,
-        env=dict(os.environ, MPLBACKEND="agg"),
+        env=dict(
+            os.environ, MPLBACKEND="agg", IPYTHONDIR=str(tmp_path)
+        ),  # the shell's history stays out of the checkout
         cwd=PACKAGE.parent,
     )
     assert done.returncode == 0, done.stderr[-3000:]

@@ -57,10 +57,14 @@ def load_course(folder):
         app = NbGrader()
         app.load_config_file()
         cd = CourseDirectory(config=app.config)
+        db_url = cd.db_url
+        if db_url.startswith("sqlite:///") and not Path(db_url[len("sqlite:///") :]).is_absolute():
+            # a relative SQLite file is where nbgrader, run in the course folder, finds it
+            db_url = f"sqlite:///{folder / db_url[len('sqlite:///') :]}"
         return Course(
             folder=folder,
             root=Path(cd.root).resolve(),
-            db_url=cd.db_url,
+            db_url=db_url,
             course_id=cd.course_id,
             submitted_directory=cd.submitted_directory,
             autograded_directory=cd.autograded_directory,

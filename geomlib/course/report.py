@@ -298,7 +298,7 @@ def render_html(results, rows, flags, picture):
         parts.append(f"<h2><code>{e(exercise)}</code> <small>{e(notebook)} · {e(head)}</small></h2>")
         parts.append("<table><tr><th>outcome</th><th>diagnosis</th><th>students</th><th>share</th><th>who</th></tr>")
         for r in group:
-            diagnosis = "" if r["diagnosis"] == r["kind"] else r["diagnosis"]
+            diagnosis = "" if r["diagnosis"].startswith(r["kind"]) else r["diagnosis"]
             parts.append(
                 f"<tr><td>{e(r['kind'])}</td><td>{e(diagnosis)}</td><td class='n'>{r['students']}</td>"
                 f"<td class='n'>{float(r['share']):.0%}</td><td><small>{e(r['student_ids'])}</small></td></tr>"

@@ -54,6 +54,7 @@ from .laplace import FaceGeometry, assemble_laplacian, check_options, face_geome
 
 __all__ = [
     "mean_curvature",
+    "signed_mean_curvature",
     "gaussian_curvature",
     "principal_curvatures",
     "angle_deficit",
@@ -127,6 +128,24 @@ def mean_curvature(V, F, weights="cotan", area="barycentric", signed=False, boun
                 f"every vertex of this mesh lies on the boundary; boundary={boundary!r} gives "
                 f"{'NaN' if boundary == 'nan' else '0'} everywhere (boundary='formula' keeps the values)"
             )
+    return H
+
+
+def signed_mean_curvature(V, F, M, C):
+    """Signed mean curvature H (n,) float64 from a Laplacian pair: ``H_i = -1/2 <(M^-1 C x)_i, n_i>``.
+
+    ``(M, C)``: (n, n) matrices of :func:`geomlib.laplacian` (any weights; M diagonal). ``n_i``: the
+    area-weighted outward unit vertex normal, the normalised sum of the cross products
+    ``(x_j - x_i) x (x_k - x_i)`` of the faces at i (each face in the order F lists it, counter-clockwise
+    seen from outside). H > 0 on a sphere. NaN at boundary vertices (one-ring incomplete). Units as
+    :func:`mean_curvature`: 1/length for the cotangent pair, a length for the uniform one (Kobbelt et al. 1998).
+    This is ``mean_curvature(V, F, weights, signed=True, boundary="nan")`` for the pair of those weights.
+    """
+    V, F = as_mesh(V, F)
+    A = np.asarray(M.diagonal(), dtype=float)
+    DX = (C @ V) / np.where(A > 0, A, np.nan)[:, None]  # Delta x = M^-1 C x, NaN where M is 0
+    H = -0.5 * np.einsum("ij,ij->i", DX, area_weighted_normals(V, F))
+    H[boundary_edge_counts(F, len(V)) > 0] = np.nan
     return H
 
 

@@ -64,7 +64,8 @@ Coercion helpers (:func:`matrix_pair`, :func:`vector`, :func:`positions`,
 :func:`eigenpairs`, :func:`number`) turn what the learner returned into float arrays or
 raise a ``Mistake``; a wrong shape or type is never partial credit (``typical=False``),
 as the grading guide says. :func:`run` calls the learner's function on copies of each
-case's inputs through ``result.call``, which names an input changed in place.
+case's inputs through ``result.call``, which names an input changed in place (:func:`answer`: one
+case, some inputs replaced).
 """
 
 import numpy as np
@@ -80,6 +81,7 @@ __all__ = [
     "first_mistake",
     "judge",
     "run",
+    "answer",
     "mesh_cases",
     "matrix_pair",
     "vector",
@@ -111,8 +113,11 @@ class Case:
 
     @property
     def n(self):
-        """The number of vertices (rows of the first input, or a fact ``n``)."""
-        return self.facts.get("n", len(next(iter(self.inputs.values()))))
+        """The number of vertices (a fact ``n``, else the rows of the first input, a sparse matrix too)."""
+        if "n" in self.facts:
+            return self.facts["n"]
+        first = next(iter(self.inputs.values()))
+        return first.shape[0] if hasattr(first, "shape") else len(first)
 
     def but(self, **facts):
         """This case with more facts (``where=`` restricts :func:`agree` to those entries)."""
@@ -206,7 +211,12 @@ def judge(catalogue, cases, answers, right, same=agree):
 
 def run(fn, cases, coerce):
     """``[coerce(fn(*inputs), case.n) for each case]``: the learner's answers, called on copies of the inputs."""
-    return [coerce(call(fn, *(_copy(x) for x in case.inputs.values())), case.n) for case in cases]
+    return [coerce(answer(fn, case), case.n) for case in cases]
+
+
+def answer(fn, case, **inputs):
+    """What ``fn`` returns on copies of the case's inputs, some replaced by ``inputs`` (another seed, say)."""
+    return call(fn, *(_copy(x) for x in {**case.inputs, **inputs}.values()))
 
 
 def mesh_cases(meshes, rng, facts=None):

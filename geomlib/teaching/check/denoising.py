@@ -35,15 +35,10 @@ from pathlib import Path
 import numpy as np
 
 from ...mesh.geometry import bounding_box_diagonal, mean_edge_length
-from .catalogue import Case, Wrong, judge, number
+from .catalogue import Case, Wrong, answer, judge, number, run
 from .result import Mistake, call, exercise
 
 __all__ = ["add_noise", "vertex_rms", "denoising_experiment", "denoising_sweep"]
-
-NOISE_SECTION = "section 2 · The noise, yours"
-RMS_SECTION = "section 3 · The error, yours"
-EXPERIMENT_SECTION = "section 4 · The experiment, yours"
-SWEEP_SECTION = "section 5 · The sweep, yours"
 
 
 def _grid(nx, ny, spacing, height):
@@ -57,6 +52,11 @@ def _grid(nx, ny, spacing, height):
 
 def _rms(X, Y):
     return float(np.sqrt(np.mean(np.sum((X - Y) ** 2, axis=1))))
+
+
+def _scalar(diagnosis, hint, value):
+    """A wrong answer that is one number, ``value(case)``."""
+    return Wrong(diagnosis, hint, build=lambda c: np.array([value(c)]))
 
 
 # ------------------------------------------------------------------ the noise
@@ -77,11 +77,7 @@ class _Noise:
         D = self.out.astype(float) - V
         self.D, self.std = D, float(D.std()) if D.any() else 0.0
         z = D / max(self.std, 1e-300)
-        self.mean, self.axes, self.kurtosis = (
-            D.mean(axis=0) / max(self.std, 1e-300),
-            D.std(axis=0) / max(self.std, 1e-300),
-            float(np.mean(z**4)),
-        )
+        self.mean, self.axes, self.kurtosis = z.mean(axis=0), z.std(axis=0), float(np.mean(z**4))
         self.correlation = float(np.abs(np.corrcoef(D.T) - np.eye(3)).max()) if np.all(D.std(axis=0) > 0) else 0.0
 
 
@@ -138,7 +134,7 @@ def _noise_ok(a, s, c):
     return not any(w.when(a, s, c) for w in NOISE_MISTAKES)
 
 
-@exercise("add_noise", reread=NOISE_SECTION, forbid=("lessons.noise.add_noise",))
+@exercise("add_noise", reread="section 2 · The noise, yours", forbid=("lessons.noise.add_noise",))
 def add_noise(fn):
     """Check ``fn(V, F, sigma, seed) -> V'``: V + sigma * d * (independent standard normals)."""
     V, F = _NOISE_V, _NOISE_F
@@ -176,21 +172,17 @@ def _rms_cases():
     return [c.but(e2=np.sum((c.V - c.V_clean) ** 2, axis=1), d=bounding_box_diagonal(c.V_clean), n=1) for c in cases]
 
 
-def _wrong_rms(diagnosis, hint, value):
-    return Wrong(diagnosis, hint, build=lambda c: np.array([value(c)]))
-
-
 # fmt: off
 RMS_MISTAKES = [
-    _wrong_rms('the result is negative', 'a root mean square is >= 0', lambda c: -np.sqrt(c.e2.mean()) / c.d),
-    _wrong_rms('the result is not relative: it is in length units, not divided by the bounding-box diagonal', 'divide by d, the bounding-box diagonal of the clean mesh', lambda c: np.sqrt(c.e2.mean())),
-    _wrong_rms('this is the mean of the distances, not the root of the mean square', 'square each distance, average, then take the square root', lambda c: np.sqrt(c.e2).mean() / c.d),
-    _wrong_rms('the mean squared error is not rooted', 'take the square root of the mean of |x_i - x_i^clean|^2', lambda c: c.e2.mean() / c.d),
-    _wrong_rms('the mean squared error is not rooted (this is RMS^2)', 'take the square root of the mean before comparing', lambda c: c.e2.mean() / c.d ** 2),
-    _wrong_rms('the squared distances are summed, not averaged', 'divide the sum by the number of vertices n before the square root', lambda c: np.sqrt(c.e2.sum()) / c.d),
-    _wrong_rms('the distances are summed, not averaged (and not squared)', 'RMS = sqrt(mean_i |x_i - x_i^clean|^2)', lambda c: np.sqrt(c.e2).sum() / c.d),
-    _wrong_rms('the mean runs over the 3n coordinates instead of the n vertices', "square the length of each vertex's displacement, then average over vertices", lambda c: np.sqrt(c.e2.mean() / 3) / c.d),
-    _wrong_rms("divided by the noisy mesh's diagonal instead of the clean one", 'd is the bounding-box diagonal of V_clean, the truth we measure against', lambda c: np.sqrt(c.e2.mean()) / bounding_box_diagonal(c.V)),
+    _scalar('the result is negative', 'a root mean square is >= 0', lambda c: -np.sqrt(c.e2.mean()) / c.d),
+    _scalar('the result is not relative: it is in length units, not divided by the bounding-box diagonal', 'divide by d, the bounding-box diagonal of the clean mesh', lambda c: np.sqrt(c.e2.mean())),
+    _scalar('this is the mean of the distances, not the root of the mean square', 'square each distance, average, then take the square root', lambda c: np.sqrt(c.e2).mean() / c.d),
+    _scalar('the mean squared error is not rooted', 'take the square root of the mean of |x_i - x_i^clean|^2', lambda c: c.e2.mean() / c.d),
+    _scalar('the mean squared error is not rooted (this is RMS^2)', 'take the square root of the mean before comparing', lambda c: c.e2.mean() / c.d ** 2),
+    _scalar('the squared distances are summed, not averaged', 'divide the sum by the number of vertices n before the square root', lambda c: np.sqrt(c.e2.sum()) / c.d),
+    _scalar('the distances are summed, not averaged (and not squared)', 'RMS = sqrt(mean_i |x_i - x_i^clean|^2)', lambda c: np.sqrt(c.e2).sum() / c.d),
+    _scalar('the mean runs over the 3n coordinates instead of the n vertices', "square the length of each vertex's displacement, then average over vertices", lambda c: np.sqrt(c.e2.mean() / 3) / c.d),
+    _scalar("divided by the noisy mesh's diagonal instead of the clean one", 'd is the bounding-box diagonal of V_clean, the truth we measure against', lambda c: np.sqrt(c.e2.mean()) / bounding_box_diagonal(c.V)),
     Wrong('the result differs from sqrt(mean_i |x_i - x_i^clean|^2) / d on {label}', "d is the clean mesh's bounding-box diagonal", typical=False),
 ]
 # fmt: on
@@ -198,14 +190,14 @@ RMS_MISTAKES = [
 
 @exercise(
     "vertex_rms",
-    reread=RMS_SECTION,
+    reread="section 3 · The error, yours",
     forbid=("lessons.metrics.vertex_rms", "lessons.metrics.denoising_metrics", "lessons.metrics.MeshComparison"),
 )
 def vertex_rms(fn):
     """Check ``fn(V, V_clean) -> float``: sqrt(mean_i |x_i - x_i^clean|^2) / d(V_clean)."""
     cases = _rms_cases()
     hint = "average over all vertices and return one float, the RMS distance divided by the diagonal"
-    answers = [np.array([number(call(fn, c.V.copy(), c.V_clean.copy()), "the function", hint)]) for c in cases]
+    answers = run(fn, cases, lambda out, n: np.array([number(out, hint=hint)]))
     judge(RMS_MISTAKES, cases, answers, right=lambda c: np.array([np.sqrt(c.e2.mean()) / c.d]))
     return [c.label for c in cases]
 
@@ -265,23 +257,19 @@ def _e(c, sigma=None, iterations=None, key="right", directions=False):
     return _run(sigma, c.tau1, c.iterations if iterations is None else max(iterations, 0), directions)[key]
 
 
-def _wrong_e(diagnosis, hint, value):
-    return Wrong(diagnosis, hint, build=lambda c: np.array([value(c)]))
-
-
 # fmt: off
 EXPERIMENT_MISTAKES = [
-    _wrong_e('one iteration short: the run without noise shrank the sphere by N - 1 steps, not N', 'smooth for exactly `iterations` steps: range(iterations)', lambda c: _e(c, iterations=c.iterations - 1)),
-    _wrong_e('one iteration too many: the run without noise shrank the sphere by N + 1 steps', 'smooth for exactly `iterations` steps', lambda c: _e(c, iterations=c.iterations + 1)),
-    _wrong_e("the error is absolute (length units): it is not divided by the clean mesh's bounding-box diagonal", 'divide the RMS distance by d, the bounding-box diagonal of V_clean', lambda c: _e(c) * c.d),
-    _wrong_e('the noise is not relative to the bounding-box diagonal: its standard deviation is sigma itself', 'scale the standard normal numbers by sigma * d, d the diagonal of V_clean', lambda c: _e(c, sigma=c.sigma / c.d)),
-    _wrong_e("the noise and the error are not both relative to the bounding-box diagonal: the noise's standard deviation is sigma itself and the error is in length units", 'noise of standard deviation sigma * d, and the RMS error divided by d', lambda c: _e(c, sigma=c.sigma / c.d) * c.d),
-    _wrong_e('the noise is scaled by the mean edge length instead of the bounding-box diagonal', 'scale the standard normal numbers by sigma * d', lambda c: _e(c, sigma=c.sigma * c.ell / c.d)),
-    _wrong_e('the error is sqrt(3) too small (its square a third of the right one): the mean runs over the 3n coordinates instead of the n vertices', 'average |p_i - x_i|^2 over the n vertices', lambda c: _e(c) / np.sqrt(3)),
-    _wrong_e('the noise is sqrt(3) too small (its square a third of the right one): each vertex moved by a random direction of length sigma * d, so each coordinate moves by only sigma * d / sqrt(3)', 'draw every coordinate with standard deviation sigma * d', lambda c: _e(c, directions=True)),
-    _wrong_e('the error is measured against the noisy mesh (the input of the smoothing), not against the clean mesh, the truth', 'return the RMS distance between the smoothed mesh and V_clean', lambda c: _e(c, key='noisy')),
-    _wrong_e('the error is that of the noisy mesh: the smoothed mesh is not the one measured', 'smooth the noisy mesh and measure the result against V_clean', lambda c: _e(c, key='noise')),
-    _wrong_e('the clean mesh was smoothed instead of the noisy one', 'smooth W = V_clean + noise, then compare with V_clean', lambda c: _e(c, sigma=0.0)),
+    _scalar('one iteration short: the run without noise shrank the sphere by N - 1 steps, not N', 'smooth for exactly `iterations` steps: range(iterations)', lambda c: _e(c, iterations=c.iterations - 1)),
+    _scalar('one iteration too many: the run without noise shrank the sphere by N + 1 steps', 'smooth for exactly `iterations` steps', lambda c: _e(c, iterations=c.iterations + 1)),
+    _scalar("the error is absolute (length units): it is not divided by the clean mesh's bounding-box diagonal", 'divide the RMS distance by d, the bounding-box diagonal of V_clean', lambda c: _e(c) * c.d),
+    _scalar('the noise is not relative to the bounding-box diagonal: its standard deviation is sigma itself', 'scale the standard normal numbers by sigma * d, d the diagonal of V_clean', lambda c: _e(c, sigma=c.sigma / c.d)),
+    _scalar("the noise and the error are not both relative to the bounding-box diagonal: the noise's standard deviation is sigma itself and the error is in length units", 'noise of standard deviation sigma * d, and the RMS error divided by d', lambda c: _e(c, sigma=c.sigma / c.d) * c.d),
+    _scalar('the noise is scaled by the mean edge length instead of the bounding-box diagonal', 'scale the standard normal numbers by sigma * d', lambda c: _e(c, sigma=c.sigma * c.ell / c.d)),
+    _scalar('the error is sqrt(3) too small (its square a third of the right one): the mean runs over the 3n coordinates instead of the n vertices', 'average |p_i - x_i|^2 over the n vertices', lambda c: _e(c) / np.sqrt(3)),
+    _scalar('the noise is sqrt(3) too small (its square a third of the right one): each vertex moved by a random direction of length sigma * d, so each coordinate moves by only sigma * d / sqrt(3)', 'draw every coordinate with standard deviation sigma * d', lambda c: _e(c, directions=True)),
+    _scalar('the error is measured against the noisy mesh (the input of the smoothing), not against the clean mesh, the truth', 'return the RMS distance between the smoothed mesh and V_clean', lambda c: _e(c, key='noisy')),
+    _scalar('the error is that of the noisy mesh: the smoothed mesh is not the one measured', 'smooth the noisy mesh and measure the result against V_clean', lambda c: _e(c, key='noise')),
+    _scalar('the clean mesh was smoothed instead of the noisy one', 'smooth W = V_clean + noise, then compare with V_clean', lambda c: _e(c, sigma=0.0)),
     Wrong("on {label} the error differs from geomlib's run (by more than 5 %, or at all without noise)", 'smooth with geomlib.implicit_smoothing(W, F, tau, iterations) (cotangent weights)', typical=False),
 ]
 # fmt: on
@@ -293,7 +281,7 @@ def _same_e(a, r, c):
 
 @exercise(
     "denoising_experiment",
-    reread=EXPERIMENT_SECTION,
+    reread="section 4 · The experiment, yours",
     forbid=(
         "lessons.noise.denoising_experiment",
         "lessons.noise.add_noise",
@@ -308,11 +296,7 @@ def _same_e(a, r, c):
 def denoising_experiment(fn):
     """Check ``fn(V_clean, F, sigma, tau, iterations, seed) -> E`` (module docstring)."""
     cases = _experiment_cases()
-    E = lambda c, **kw: number(
-        call(fn, *(x.copy() if hasattr(x, "copy") else x for x in {**c.inputs, **kw}.values())),
-        "the function",
-        "return the one relative error, a float",
-    )  # noqa: E731
+    E = lambda c, **kw: number(answer(fn, c, **kw), hint="return the one relative error, a float")
     answers = [np.array([E(c)]) for c in cases]
     if not np.isclose(E(cases[1]), answers[1][0], rtol=1e-9, atol=0):
         raise Mistake(
@@ -356,14 +340,8 @@ def _sweep_table(W, F, truth, taus, iterations, weights="cotan", step="implicit"
 
 
 #: the wrong tables the catalogue names, by the options of _sweep_table that make them
-_VARIANTS = {
-    "carry": {"carry": True},
-    "rebuild": {"rebuild": True},
-    "explicit": {"step": "explicit"},
-    "plus": {"step": "plus"},
-    "rhs P": {"step": "rhs P"},
-    "uniform": {"weights": "uniform"},
-}
+_VARIANTS = {"carry": {"carry": True}, "rebuild": {"rebuild": True}, "uniform": {"weights": "uniform"}}
+_VARIANTS |= {step: {"step": step} for step in ("explicit", "plus", "rhs P")}
 
 
 def _best(E, taus, count_from=0, pick=np.argmin, index=False):
@@ -410,12 +388,9 @@ def _sweep_flat(out, case):
     return np.concatenate([[tau / case.taus[-1], count / case.iterations], E.ravel() / case.right[2].max()])
 
 
-def _as(case, tau_N_E):
-    return _sweep_flat(tau_N_E, case)
-
-
 def _wrong(diagnosis, hint, make):
-    return Wrong(diagnosis, hint, build=lambda c: _as(c, make(c)))
+    """A wrong triple (tau_best, N_best, E), ``make(case)``."""
+    return Wrong(diagnosis, hint, build=lambda c: _sweep_flat(make(c), c))
 
 
 # fmt: off
@@ -439,7 +414,7 @@ SWEEP_MISTAKES = [
 
 @exercise(
     "denoising_sweep",
-    reread=SWEEP_SECTION,
+    reread="section 5 · The sweep, yours",
     forbid=(
         "lessons.noise.denoising_sweep",
         "lessons.smoothing.implicit_smoothing",
@@ -455,8 +430,6 @@ SWEEP_MISTAKES = [
 def denoising_sweep(fn):
     """Check ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` (section 5 of notebook 07)."""
     cases = _sweep_cases()
-    answers = [
-        _sweep_flat(call(fn, *(x.copy() if hasattr(x, "copy") else x for x in c.inputs.values())), c) for c in cases
-    ]
-    judge(SWEEP_MISTAKES, cases, answers, right=lambda c: _as(c, c.right))
+    answers = [_sweep_flat(answer(fn, c), c) for c in cases]
+    judge(SWEEP_MISTAKES, cases, answers, right=lambda c: _sweep_flat(c.right, c))
     return [c.label + f" ({len(c.taus)} steps, {c.iterations} iterations)" for c in cases]

@@ -212,7 +212,7 @@ LOOP_MISTAKES = loop_mistakes(explicit_loop, [
 )
 def smoothing_loop(fn):
     """Check ``fn(V, F, tau, N) -> P``: N explicit steps, M and C of V built once, the boundary held, and a
-    step at or past 2 / lam_max of the interior block refused with an exception."""
+    step at or past 2 / lam_max of the interior block refused with an exception, one just below it taken."""
     rng, cases = case_rng(), []
     grid = placed(*loop_grid(), rng)
     for label, (V, F), N in (
@@ -236,7 +236,18 @@ def smoothing_loop(fn):
             f"a step of 1.05 times the limit 2 / lam_max = {past.limit:.4g} ran instead of being refused",
             "before the first step: if tau >= 2 / lam_max (of M_II, C_II), raise ValueError naming both",
         )
-    return [c.label for c in cases] + ["a step past the limit, refused"]
+    near = 0.95  # past the whole pair's limit on the grid: 2 / lam_max of (M, C) is 0.89 of the block's
+    try:
+        call(fn, past.V.copy(), past.F.copy(), near * past.limit, 1)
+    except Mistake as m:
+        if not m.diagnosis.startswith(_RAISED + "ValueError"):
+            raise
+        raise Mistake(
+            f"a stable step, {near} times the limit, was refused: the limit comes from the whole pair (M, C), "
+            "not from its interior block",
+            "lam_max of (M_II, C_II), the rows and columns of the interior vertices",
+        ) from None
+    return [c.label for c in cases] + ["a step past the limit, refused", f"a step of {near} times it, taken"]
 
 
 _RAISED = "the function raised "  # how result.call names an exception of the learner's function

@@ -207,12 +207,7 @@ class _Rules:
         tools = list(self.tools)
         if self.allow:
             tools[-1:] = [tools[-1], "geomlib's " + _listed([f"`{_public(d)}`" for d in self.allow])]
-        named = ", ".join(f"`{_public(d)}`" for d in self.forbid[:2])  # the nearest shortcuts
-        such = f" (such as {named})" if named else ""
-        return (
-            f"Ground rules: {_listed(tools)} only; any other geomlib routine{such}, a geometry library "
-            "(libigl, trimesh, ...) or a copy of geomlib's code earns no points."
-        )
+        return f"Ground rules: {_listed(tools)} only: no other geomlib routine, geometry library or copied code."
 
     def refusal(self, name, why=""):
         if why:

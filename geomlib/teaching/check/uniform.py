@@ -1,4 +1,5 @@
-"""Checks of the exercises of notebook 01: the uniform Laplacian and the angle-deficit Gaussian curvature.
+"""Checks of the exercises of notebook 01: the uniform Laplacian, its signed mean curvature and the angle-deficit
+Gaussian curvature.
 
 Each check runs the learner's function on a closed mesh whose valences are all equal (a tetrahedron), an
 open one (a grid: boundary vertices and edges), and a closed one whose valences differ and which holds
@@ -11,15 +12,16 @@ triangles on a closed mesh) are told apart by the others.
 
 import numpy as np
 
-from ...lessons.curvature import angle_deficit, boundary_mask
+from ...lessons.curvature import angle_deficit, boundary_mask, signed_mean_curvature
 from ...lessons.curvature import gaussian_curvature as geomlib_gaussian_curvature
 from ...lessons.laplace import barycentric_areas, laplacian
+from ...mesh.geometry import face_cross, face_normals
 from .area_mistakes import AREA_MISTAKES
-from .catalogue import Wrong, agree, first_mistake, judge, matrix_pair, mesh_cases, run, vector
+from .catalogue import Case, Wrong, agree, first_mistake, judge, matrix_pair, mesh_cases, run, vector
 from .meshes import bump_4x4, corner_tetrahedron, grid_3x3, jittered_icosphere
 from .result import case_rng, exercise
 
-__all__ = ["gaussian_curvature", "uniform_laplacian"]
+__all__ = ["gaussian_curvature", "mean_curvature", "uniform_laplacian"]
 
 # the rules in the learner's own terms, for the hints
 _C_RULE = "C_ij = 1 for each edge ij (however many triangles share it), C_ii = -(number of neighbours of i)"
@@ -86,6 +88,12 @@ C_MISTAKES = [
         build=lambda c: c.C_cot,
     ),
     Wrong(
+        "C holds diag(1/valence), the inverse of M, not the weights: the factors of M^-1 C handed in the wrong slots",
+        "return M, C with M = diag(valence) and " + _C_RULE,
+        build=lambda c: np.diag(1 / c.valence),
+    ),
+    Wrong("(M, C) are swapped: C holds diag(valence)", "end with `return M, C`: M first", build=lambda c: c.M),
+    Wrong(
         "C is not symmetric on {label}", "set both C_ij and C_ji for every edge", when=lambda C, _, c: not agree(C, C.T)
     ),
     Wrong("C differs from the uniform Laplacian on {label}", _C_RULE, typical=False),
@@ -118,6 +126,97 @@ def uniform_laplacian(fn):
     return [c.label for c in cases]
 
 
+def _normal_sums(V, F, per_face):
+    """(n, 3): at each vertex, the sum of ``per_face`` (m, 3) over the faces at it."""
+    return np.stack([np.bincount(F.ravel(), np.repeat(per_face[:, k], 3), minlength=len(V)) for k in range(3)], 1)
+
+
+def _mean_facts(V, F, M, C):
+    """The right H and what the mistakes are made of: Delta x, the normal sums, the boundary."""
+    A = M.diagonal()
+    N2, N1 = _normal_sums(V, F, face_cross(V, F)), _normal_sums(V, F, face_normals(V, F))
+    facts = dict(H=signed_mean_curvature(V, F, M, C), DX=(C @ V) / A[:, None], CX=C @ V, N2=N2)
+    facts.update(N=N2 / np.linalg.norm(N2, axis=1)[:, None], N1=N1 / np.linalg.norm(N1, axis=1)[:, None])
+    return dict(facts, boundary=boundary_mask(V, F))
+
+
+def mean_cases(rng):
+    """The cases of ``mean_curvature``, placed with ``rng``: three meshes with their uniform (M, C), and the
+    icosphere with its cotangent (M, C), so that M is read from the input, not rebuilt from the valences."""
+    meshes = (_TETRAHEDRON, ("a bump on a 4 x 4 grid", bump_4x4()), _ICOSPHERE, _ICOSPHERE)
+    cases = []
+    for k, c in enumerate(mesh_cases(meshes, rng)):
+        cotan = k == 3
+        M, C = laplacian(c.V, c.F) if cotan else laplacian(c.V, c.F, weights="uniform")
+        label = c.label + (" with the cotangent (M, C)" if cotan else "")
+        cases.append(Case(label, V=c.V, F=c.F, M=M, C=C).but(**_mean_facts(c.V, c.F, M, C)))
+    return cases
+
+
+def _normal_part(X, N):
+    return -0.5 * np.einsum("ij,ij->i", X, N)
+
+
+_H_RULE = "H_i = -1/2 <(M^-1 C x)_i, n_i>, n_i the normalised sum of the cross products of the faces at i"
+H_MISTAKES = [
+    Wrong(
+        "H has the wrong sign: the normals point inward, or the minus sign of -1/2 <M^-1 C x, n> is missing",
+        "each face's (x_j - x_i) x (x_k - x_i), in the order F lists it, points outward; H > 0 on a sphere",
+        build=lambda c: -c.H,
+    ),
+    Wrong("the factor 1/2 is missing", _H_RULE, build=lambda c: 2 * c.H),
+    Wrong(
+        "M^-1 is missing: C x sums the neighbours' differences, M^-1 C x is the Laplacian",
+        "divide row i of C x by M_ii",
+        build=lambda c: _normal_part(c.CX, c.N),
+    ),
+    Wrong(
+        "the normals are not normalised (the sum of the cross products has length twice the fan's area)",
+        "divide each vertex's sum of cross products by its length",
+        build=lambda c: _normal_part(c.DX, c.N2),
+    ),
+    Wrong(
+        "H is unsigned: 1/2 |M^-1 C x| drops the side the surface bends to",
+        "project onto the normal: " + _H_RULE,
+        build=lambda c: 0.5 * np.linalg.norm(c.DX, axis=1),
+    ),
+    Wrong(
+        "the normals average the unit face normals (equal weights), not the area-weighted sum asked for",
+        "sum the cross products themselves, whose length is twice each face's area, and normalise the sum",
+        build=lambda c: _normal_part(c.DX, c.N1),
+    ),
+    Wrong("H differs from -1/2 <M^-1 C x, n> at interior vertices of {label}", _H_RULE, typical=False),
+]
+H_BOUNDARY_MISTAKES = [
+    Wrong(
+        "the formula is applied at boundary vertices (no boundary rule)",
+        "the one-ring of a boundary vertex is open, M^-1 C x points along the surface there: return NaN",
+        build=lambda c: _normal_part(c.DX, c.N),
+    ),
+    Wrong("boundary vertices have a value (the wrong boundary rule)", "return NaN (np.nan) at boundary vertices"),
+]
+
+
+@exercise(
+    "mean_curvature",
+    reread="section 4 · The signed mean curvature",
+    forbid=(
+        "lessons.curvature.signed_mean_curvature",
+        "lessons.curvature.mean_curvature",
+        "mesh.geometry.vertex_normals",
+        "mesh.geometry.face_normals",
+    ),
+    allow=("lessons.curvature.boundary_mask",),
+)
+def mean_curvature(fn):
+    """Check ``fn(V, F, M, C) -> (n,)``: H_i = -1/2 <(M^-1 C x)_i, n_i>, n_i area-weighted, NaN on the boundary."""
+    cases = mean_cases(case_rng())
+    Hs = run(fn, cases, vector)
+    judge(H_MISTAKES, [c.but(where=~c.boundary) for c in cases], Hs, lambda c: c.H)
+    judge(H_BOUNDARY_MISTAKES, [c.but(where=c.boundary) for c in cases], Hs, lambda c: c.H)
+    return [c.label for c in cases]
+
+
 def curvature_cases(rng):
     """The cases of ``gaussian_curvature``, placed with ``rng``: the bump is open, so that interior K is
     clearly non-zero and the boundary rule matters (valences 2 to 4 along its boundary, 6 inside)."""
@@ -140,6 +239,21 @@ def same_K(K, K_ref, case):
     return bool(np.all(both_nan | near))
 
 
+def _index_order_sums(c):
+    """2 pi - the angles at each vertex between its neighbours in index order, the last to the first."""
+    ring = [set() for _ in range(len(c.V))]
+    for i, j, k in c.F:
+        ring[i] |= {j, k}
+        ring[j] |= {k, i}
+        ring[k] |= {i, j}
+    total = np.zeros(len(c.V))
+    for i, around in enumerate(ring):
+        e = c.V[sorted(around)] - c.V[i]
+        e /= np.linalg.norm(e, axis=1, keepdims=True)
+        total[i] = np.arccos(np.clip(np.einsum("ij,ij->i", e, np.roll(e, -1, axis=0)), -1, 1)).sum()
+    return 2 * np.pi - total
+
+
 K_MISTAKES = [
     Wrong(
         "the sign of the deficit is flipped (sum of angles - 2 pi)",
@@ -156,6 +270,12 @@ K_MISTAKES = [
         "the deficit is not divided by the vertex area (integrated, not pointwise, K)",
         "divide 2 pi - sum of angles by A_i",
         build=lambda c: c.deficit,
+    ),
+    Wrong(
+        "the angles are taken between neighbours in index order, not in the ring order around the vertex: two "
+        "neighbours next to each other in a sorted list need not share a triangle with it",
+        "sum the angles of the triangles at i, one per face (each face gives its corner angle at i)",
+        build=lambda c: _index_order_sums(c) / c.A,
     ),
     *(
         Wrong(area.diagnosis, area.hint, build=lambda c, area=area: c.deficit / area.build(c))
