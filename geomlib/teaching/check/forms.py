@@ -70,7 +70,8 @@ def _values(exprs, symbols, points, learner=True):
     f = sp.lambdify(symbols, exprs, modules="numpy")
     with np.errstate(all="ignore"):
         vals = np.array([np.broadcast_to(np.asarray(f(*pt), dtype=complex), 6) for pt in points]).T
-    if learner and not np.all(np.isfinite(vals)) or np.abs(vals.imag).max() > 1e-9 * (1 + np.abs(vals.real).max()):
+    real = np.all(np.isfinite(vals)) and np.abs(vals.imag).max() <= 1e-9 * (1 + np.abs(vals.real).max())
+    if learner and not real:
         raise Mistake(
             "the expressions are not real numbers at points inside the domain",
             "check square roots and divisions: 0 < v < pi, a, b, c > 0",
@@ -99,7 +100,6 @@ def _same_factor(got, right):
 
 
 _UV = [2, 1, 0, 5, 4, 3]  # E, F, G, e, f, g with the roles of u and v exchanged
-
 # fmt: off
 FORMS_MISTAKES = [
     # the learner's p(u, v) is the true p(v, u): its p_u is the true p_v, and p_u x p_v turns round
@@ -153,9 +153,8 @@ def fundamental_forms(fn):
 
 def _kappa(k, du, dv, two=2.0, divide=True):
     """II(t, t) / I(t, t) (or II(t, t) alone) for the forms k = (E, F, G, e, f, g) and t = (du, dv)."""
-    E, F, G, e, f, g = k
-    II_tt, I_tt = e * du**2 + two * f * du * dv + g * dv**2, E * du**2 + two * F * du * dv + G * dv**2
-    return II_tt / I_tt if divide else II_tt
+    form = lambda X, Y, Z: X * du**2 + two * Y * du * dv + Z * dv**2  # t^T [[X, Y], [Y, Z]] t
+    return form(*k[3:]) / form(*k[:3]) if divide else form(*k[3:])
 
 
 def _tangent(k, phi):
