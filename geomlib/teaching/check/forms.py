@@ -377,10 +377,9 @@ _PRINCIPAL = "kappa_1,2 = H +- sqrt(H^2 - K), H = tr(I^-1 II) / 2, K = det II / 
 
 
 def principal_cases(rng):
-    """(I, II) pairs as sympy matrices with the points (values of their symbols) they are read at, and the
-    numbers E..g there: the ellipsoid at (a, 0, 0) in the symbols a, b, c (an umbilic where b = c); the
-    sphere of radius r (every point an umbilic); a Monge patch z = h(x, y) at a point with F, f != 0 and
-    K < 0, exact; the ellipsoid at a point where F != 0, in floats."""
+    """(I, II) in sympy, the points (values of their symbols) they are read at, and I, II there: the ellipsoid
+    at (a, 0, 0) (an umbilic where b = c), the sphere (all umbilics), a Monge patch z = h(x, y) at a point
+    with F, f != 0 and K < 0 (exact), the ellipsoid at a point where F != 0 (floats)."""
     import sympy as sp
 
     from ...lessons.symbolic import ellipsoid_forms
@@ -392,28 +391,14 @@ def principal_cases(rng):
     W = sp.sqrt(1 + hx**2 + hy**2)
     A, B, C = rng.uniform(0.6, 2.0, 3)
     u0, v0 = rng.uniform(0.3, 1.2), rng.uniform(0.4, 1.2)
+    sphere = (sp.diag(r**2 * sp.sin(v) ** 2, r**2), sp.diag(r * sp.sin(v) ** 2, r))
+    monge = (sp.Matrix([[1 + hx**2, hx * hy], [hx * hy, 1 + hy**2]]), sp.Matrix([[hxx, hxy], [hxy, hyy]]) / W)
+    at_F = f"the ellipsoid ({A:.2f}, {B:.2f}, {C:.2f}) at (u, v) = ({u0:.2f}, {v0:.2f}), where F != 0"
     pairs = [
         ("the ellipsoid at (a, 0, 0)", sp.diag(b**2, c**2), sp.diag(a, a), (a, b, c), abc),
-        (
-            "the sphere of radius r",
-            sp.diag(r**2 * sp.sin(v) ** 2, r**2),
-            sp.diag(r * sp.sin(v) ** 2, r),
-            (r, v),
-            [rng.uniform([0.3, 0.2], [3.0, 2.9]) for _ in range(3)],
-        ),
-        (
-            "a Monge patch at a point where K < 0 and F, f != 0",
-            sp.Matrix([[1 + hx**2, hx * hy], [hx * hy, 1 + hy**2]]),
-            sp.Matrix([[hxx, hxy], [hxy, hyy]]) / W,
-            (),
-            [()],
-        ),
-        (
-            f"the ellipsoid ({A:.2f}, {B:.2f}, {C:.2f}) at (u, v) = ({u0:.2f}, {v0:.2f}), where F != 0",
-            *ellipsoid_forms(float(A), float(B), float(C), float(u0), float(v0)),
-            (),
-            [()],
-        ),
+        ("the sphere of radius r", *sphere, (r, v), [rng.uniform([0.3, 0.2], [3.0, 2.9]) for _ in range(3)]),
+        ("a Monge patch at a point where K < 0 and F, f != 0", *monge, (), [()]),
+        (at_F, *ellipsoid_forms(*(float(x) for x in (A, B, C, u0, v0))), (), [()]),
     ]
     cases = []
     for label, I, II, symbols, points in pairs:
