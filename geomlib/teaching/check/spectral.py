@@ -176,6 +176,16 @@ def _boundary_rows(c):
     return _project(c, E=E)
 
 
+def _in_uniform_span(a, c):
+    """Whether V_k lies in the span of the uniform eigenvectors up to lam_{k-1}'s whole eigenspace, which
+    repeats on a subdivided icosahedron's graph: any basis of a cut eigenspace gives another V_k."""
+    M, C = laplacian(c.V, c.F, weights="uniform")
+    m = M.diagonal()
+    lam, Z = _eig(C, 1 / np.sqrt(m))
+    S = Z[:, lam <= lam[c.k - 1] + 1e-9 * lam[-1]] / np.sqrt(m)[:, None]
+    return agree(S @ (S.T @ (m[:, None] * a)), a)
+
+
 def _eig_rows(c):
     lam, U = np.linalg.eig(-c.C.toarray())
     U = U.real[np.argsort(lam.real)][:, : c.k]
@@ -205,6 +215,8 @@ RECONSTRUCTION_MISTAKES = [
     Wrong("k is off by one: one eigenvector too many", "E[:, :k] holds e_0 .. e_{k-1}", build=lambda c: _project(c, k=c.k + 1)),
     Wrong("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
           "laplacian(V, F) with its default weights", build=lambda c: _other_basis(c, weights="uniform")),
+    Wrong("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
+          "laplacian(V, F) with its default weights", when=lambda a, right, c: _in_uniform_span(a, c)),
     Wrong("the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked",
           "laplacian(V, F) with its default area", build=lambda c: _other_basis(c, area="mixed")),
     Wrong("the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
