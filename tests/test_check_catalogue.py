@@ -1,8 +1,6 @@
 """The form checks are written in (geomlib.teaching.check.catalogue): the one matcher's rules, the coercion
 helpers' refusals, the cases' seed, tried on the module docstring's own example check."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from diagnoses import assert_diagnosed, replaying
@@ -214,15 +212,3 @@ def test_an_answer_the_check_cannot_read_is_a_failed_check_without_points():
     assert_diagnosed(result, "could not be read as an answer (ValueError", "Reread section 0")
     assert not result.partial and result.written
     assert a_number.evaluate(lambda: 2).passed
-
-
-# ---------------------------------------------------------------- the budget of issue 39
-def test_every_check_module_holds_at_most_110_lines_per_exercise():
-    """All lines of a check module (docstrings included) over its @exercise checks: at most 110 each."""
-    modules = [(path, path.read_text()) for path in sorted(Path(check.__file__).parent.glob("*.py"))]
-    counts = {path.name: (len(text.splitlines()), text.count("\n@exercise(")) for path, text in modules}
-    counts = {name: (lines, n) for name, (lines, n) in counts.items() if n}
-    assert len(counts) >= 6, f"the check modules with @exercise checks: {sorted(counts)}"
-    over = [f"{name}: {lines} lines / {n} exercises = {lines / n:.1f}" for name, (lines, n) in counts.items()]
-    over = [o for o, (lines, n) in zip(over, counts.values()) if lines / n > 110]
-    assert not over, "over 110 lines per exercise: " + "; ".join(over)
