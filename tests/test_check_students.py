@@ -430,6 +430,60 @@ def kappa_parameter_angle(forms, a, b, c, u, v, phi):
     return (e * du * du + 2 * f * du * dv + g * dv * dv) / (E * du * du + 2 * F * du * dv + G * dv * dv)
 
 
+# ============================================================================ 02 · principal_curvatures
+
+
+@student("principal_curvatures")
+def principal_H_K(I, II):
+    import sympy as sy
+
+    L = I.inv() * II
+    H = L.trace() / 2
+    K = II.det() / I.det()
+    return H + sy.sqrt(H**2 - K), H - sy.sqrt(H**2 - K)
+
+
+@student("principal_curvatures")
+def principal_characteristic_polynomial(I, II):
+    import sympy as sy
+
+    (E, F), (_, G) = I.tolist()
+    (e, f), (_, g) = II.tolist()
+    # det(II - kappa I) = 0, a quadratic a kappa^2 + b kappa + c
+    a = E * G - F**2
+    b = -(e * G - 2 * f * F + g * E)
+    c = e * g - f**2
+    disc = sy.sqrt(b**2 - 4 * a * c)
+    return (-b + disc) / (2 * a), (-b - disc) / (2 * a)
+
+
+@student("principal_curvatures", named="the pair is in the wrong order")
+def principal_wrong_order(I, II):
+    import sympy as sy
+
+    H = (I.inv() * II).trace() / 2
+    K = II.det() / I.det()
+    return H - sy.sqrt(H**2 - K), H + sy.sqrt(H**2 - K)
+
+
+@student("principal_curvatures", named="I is left out")
+def principal_of_II(I, II):
+    import sympy as sy
+
+    H = II.trace() / 2
+    K = II.det()
+    return H + sy.sqrt(H * H - K), H - sy.sqrt(H * H - K)
+
+
+@student("principal_curvatures", named="not half of it")
+def principal_full_trace(I, II):
+    import sympy as sy
+
+    H = (I.inv() * II).trace()
+    K = II.det() / I.det()
+    return H + sy.sqrt(H**2 - K), H - sy.sqrt(H**2 - K)
+
+
 # ============================================================================ 03 · cotangent_matrix
 
 
