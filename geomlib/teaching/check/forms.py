@@ -15,7 +15,7 @@ from .result import Mistake, call, case_rng, exercise
 __all__ = ["fundamental_forms", "normal_curvature", "principal_curvatures"]
 
 _PAIR = "return the pair (I, II): I = Matrix([[E, F], [F, G]]), II = Matrix([[e, f], [f, g]])"
-_SURFACES = ("lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid")  # forbidden in both exercises
+_SURFACES = ("lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid")  # forbidden in every exercise
 _OWN = ("lessons.symbolic.forms_normal_curvature", "lessons.symbolic.unit_tangent")
 
 
@@ -219,7 +219,6 @@ def normal_curvature(fn):
     return [c.label for c in cases]
 
 
-# ------------------------------------------------------------------------------------ principal_curvatures
 _PRINCIPAL = "kappa_1,2 = H +- sqrt(H^2 - K), H = tr(I^-1 II) / 2, K = det II / det I: the eigenvalues of L = I^-1 II"
 
 
@@ -300,42 +299,24 @@ def _pair(out, case):
     return np.where(np.abs(values.imag) > 1e-9 * (1 + np.abs(values.real)), np.nan, values.real)
 
 
+# fmt: off
 PRINCIPAL_MISTAKES = [
-    Wrong(
-        "kappa_1 < kappa_2: the pair is in the wrong order",
-        "kappa_1 = H + sqrt(H^2 - K) is the larger",
-        build=lambda c: _eig(c.I_at, c.II_at)[:, ::-1],
-    ),
-    Wrong(
-        "the curvatures are the eigenvalues of II alone: I is left out",
-        _PRINCIPAL,
-        build=lambda c: _eig(np.eye(2)[None].repeat(len(c.points), 0), c.II_at),
-    ),
-    Wrong(
-        "the curvatures are the eigenvalues of II^-1 I: radii 1/kappa, not curvatures",
-        _PRINCIPAL,
-        build=lambda c: -np.sort(-1 / _eig(c.I_at, c.II_at), axis=1),
-    ),
+    Wrong("kappa_1 < kappa_2: the pair is in the wrong order", "kappa_1 = H + sqrt(H^2 - K) is the larger", build=lambda c: _eig(c.I_at, c.II_at)[:, ::-1]),
+    Wrong("the curvatures are the eigenvalues of II alone: I is left out", _PRINCIPAL, build=lambda c: _eig(np.eye(2)[None].repeat(len(c.points), 0), c.II_at)),
+    Wrong("the curvatures are the eigenvalues of II^-1 I: radii 1/kappa, not curvatures", _PRINCIPAL, build=lambda c: -np.sort(-1 / _eig(c.I_at, c.II_at), axis=1)),
     Wrong("H and K are swapped: K +- sqrt(K^2 - H)", _PRINCIPAL, build=lambda c: _from_HK(*_HK(c)[::-1])),
     Wrong("H is the trace of L, not half of it", _PRINCIPAL, build=lambda c: _from_HK(2 * _HK(c)[0], _HK(c)[1])),
-    Wrong(
-        "the root is sqrt(H^2 + K): the sign of K under the root",
-        "(kappa_1 - kappa_2)^2 / 4 = H^2 - K",
-        build=lambda c: _from_HK(_HK(c)[0], -_HK(c)[1]),
-    ),
+    Wrong("the root is sqrt(H^2 + K): the sign of K under the root", "(kappa_1 - kappa_2)^2 / 4 = H^2 - K", build=lambda c: _from_HK(_HK(c)[0], -_HK(c)[1])),
     Wrong("K is det II, not det II / det I", _PRINCIPAL, build=lambda c: _from_HK(_HK(c)[0], np.linalg.det(c.II_at))),
     Wrong("the principal curvatures differ from the eigenvalues of I^-1 II on {label}", _PRINCIPAL, typical=False),
 ]
+# fmt: on
 
 
 @exercise(
     "principal_curvatures",
     reread="After the discussion · the shape operator L = I^-1 II and its eigenvalues",
-    forbid=(
-        "lessons.symbolic.forms_principal_curvatures",
-        "lessons.symbolic.ParametricSurface",
-        "lessons.symbolic.ellipsoid",
-    ),
+    forbid=("lessons.symbolic.forms_principal_curvatures", *_SURFACES),
     tools=("sympy", "numpy", "scipy"),
 )
 def principal_curvatures(fn):
