@@ -7,7 +7,7 @@ process, where it can be refused (a student's interactive check). The slow ones 
 small nbgrader course (01 and 03, with the course's one configuration line for
 ``geomlib.teaching.grading.JudgeExercises``) and let a real ``nbgrader autograde`` grade
 an honest student, a student with one typical mistake and four students who hand in
-the whole catalogue (four cheats each, one per exercise): every cheating exercise
+the whole catalogue (four cheats each, other exercises left as released): every cheating exercise
 scores 0 and its feedback names what it did, while the honest student scores full
 points. A replay of answers recorded from one run's cases passes that run and fails the
 next (fresh cases each run). The lambda_max cheat (``numerics.eigen.largest_eigenpair``,
@@ -386,7 +386,7 @@ def hand_in(course, student, notebooks, edit):
         written = solutions(nb_id)
         for _, cell in build_assignment.solution_cells(nb):
             exercise = cell.metadata["nbgrader"]["grade_id"]
-            cell.source = edit(exercise, written[exercise])
+            cell.source = edit(exercise, written[exercise], cell.source)  # the solution, the released stub
         for _, cell in build_assignment.answer_cells(nb):
             cell.source = "My answer, in a few sentences, from the numbers above."
         nbformat.write(nb, out / f"{name}.ipynb")
@@ -408,12 +408,12 @@ def course(tmp_path_factory):
     for name in NOTEBOOKS.values():
         (source / f"{name}.ipynb").write_bytes((ROOT / "notebooks" / f"{name}.ipynb").read_bytes())
     nbgrader(course, "generate_assignment", ASSIGNMENT)
-    hand_in(course, "honest", NOTEBOOKS, lambda exercise, source: source)
-    hand_in(course, "mistaken", ["01"], flip_the_sign_of_C)
+    hand_in(course, "honest", NOTEBOOKS, lambda exercise, source, stub: source)
+    hand_in(course, "mistaken", ["01"], lambda exercise, source, stub: flip_the_sign_of_C(exercise, source))
     recorded = record_uniform_laplacian(REPLAY_SEED)
     for student, names in CHEATERS.items():
         by_exercise = {CHEATS[n][1]: cheat_source(n, recorded) for n in names}
-        hand_in(course, student, NOTEBOOKS, lambda exercise, source, by=by_exercise: by[exercise])
+        hand_in(course, student, NOTEBOOKS, lambda exercise, source, stub, by=by_exercise: by.get(exercise, stub))
     nbgrader(course, "autograde", ASSIGNMENT)
     return course
 
