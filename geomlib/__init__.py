@@ -81,6 +81,7 @@ _EXPORTS = {
     "mode_factor": "lessons.filters",
     "plot_mode_factors": "teaching.figures.filter_plots",
     "fixed_point": "lessons.smoothing",
+    "volume_rescaled": "lessons.smoothing",
     "ExplicitSmoother": "lessons.smoothing",
     "ImplicitSmoother": "lessons.smoothing",
     # noise and evaluation

@@ -67,6 +67,12 @@ WRONG_NOISE = {
         ),
         "not Gaussian",
     ),
+    "uniform in [-s, s] (its standard deviation s / sqrt(3), as a random direction's)": (
+        lambda V, F, sigma, seed: (
+            V + sigma * bounding_box_diagonal(V) * np.random.default_rng(seed).uniform(-1, 1, V.shape)
+        ),
+        "not Gaussian",
+    ),
     "random direction of length s": (
         lambda V, F, sigma, seed: (
             V
@@ -230,6 +236,10 @@ WRONG_EXPERIMENTS = {
     "against the noisy mesh": (
         experiment(seeded, lambda P, W, V: _rms(P, W) / bounding_box_diagonal(V)),
         "against the noisy mesh",
+    ),
+    "against the noisy mesh, over its own diagonal (my_vertex_rms(P, W))": (
+        experiment(seeded, lambda P, W, V: _rms(P, W) / bounding_box_diagonal(W)),
+        "against the noisy mesh W",
     ),
     "unseeded": (
         experiment(lambda V, s, seed: V + s * bounding_box_diagonal(V) * np.random.standard_normal(V.shape), relative),

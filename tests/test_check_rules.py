@@ -32,6 +32,7 @@ SHORTCUTS = {
         -(sp.diags(M.diagonal() ** -0.5) @ C @ sp.diags(M.diagonal() ** -0.5))
     ),
     "implicit_loop": lambda V, F, tau, iterations: smoothing.implicit_smoothing(V, F, tau, iterations),
+    "volume_kept": lambda P, F, V: smoothing.volume_rescaled(P, F, V),
     "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
     "vertex_rms": geomlib.vertex_rms,

@@ -1,4 +1,4 @@
-"""The exercise checks of notebooks 05 and 06: each accepts the reference solution and its
+"""The exercise checks of notebooks 05 and 06 (the loops and the volume kept): each accepts the reference solution and its
 legitimate variants (power iteration or Lanczos; any way of holding the boundary; splu, a
 dense solve or cg at its default tolerance, factorised once or every step), names every
 entry of its catalogue of typical mistakes when a learner's code (written here with numpy
@@ -13,7 +13,8 @@ import scipy.sparse.linalg as sla
 
 from geomlib import boundary_vertices, check, laplacian
 from geomlib.teaching.check.explicit import LAM_MAX_MISTAKES, LOOP_MISTAKES
-from geomlib.teaching.check.implicit import IMPLICIT_MISTAKES
+from geomlib.teaching.check.implicit import IMPLICIT_MISTAKES, VOLUME_MISTAKES
+from geomlib.teaching.check.meshes import jittered_icosphere
 
 
 @pytest.fixture(autouse=True)
@@ -267,7 +268,7 @@ def test_every_named_mistake_of_a_catalogue_has_a_learner_here(catalogue, learne
         assert any(name in entry.diagnosis for name in learners), entry.diagnosis
 
 
-@pytest.mark.parametrize("name", ["lam_max", "smoothing_loop", "implicit_loop"])
+@pytest.mark.parametrize("name", ["lam_max", "smoothing_loop", "implicit_loop", "volume_kept"])
 def test_a_stub_is_not_written_yet(name):
     def stub(*args):
         raise NotImplementedError
@@ -281,3 +282,77 @@ def test_the_checks_pass_whatever_the_seed():
         assert check.lam_max.evaluate(power, seed=seed).passed
         assert check.smoothing_loop.evaluate(explicit, seed=seed).passed
         assert check.implicit_loop.evaluate(implicit, seed=seed).passed
+        assert check.volume_kept.evaluate(rescaled, seed=seed).passed
+
+
+# --------------------------------------------------------------------------- the volume kept
+
+
+def rescaled(P, F, V, origin=None, cube=True, about_solid=True, back=True, sixth=True, corner=4.0):
+    """A learner's volume rescaling: signed tetrahedra with ``origin`` (default the coordinate origin), with
+    the named changes."""
+    o = np.zeros(3) if origin is None else origin
+
+    def solid(X):
+        x0, x1, x2 = X[F[:, 0]] - o, X[F[:, 1]] - o, X[F[:, 2]] - o
+        vol_f = np.linalg.det(np.stack([x0, x1, x2], axis=1)) / (6.0 if sixth else 1.0)
+        return vol_f.sum(), o + (x0 + x1 + x2).T @ vol_f / (corner * vol_f.sum())
+
+    (vol0, c0), (vol, c) = solid(V), solid(P)
+    if not about_solid:
+        c0, c = V.mean(axis=0), P.mean(axis=0)
+    s = (vol0 / vol) ** (1 / 3 if cube else 1.0)
+    return (c0 if back else c) + s * (P - c)
+
+
+@pytest.mark.parametrize(
+    "fn",
+    [
+        rescaled,
+        lambda P, F, V: rescaled(P, F, V, origin=V[0]),  # the tetrahedra's apex at a vertex: the same solid
+        lambda P, F, V: rescaled(P, F, V, sixth=False),  # the 1/6 cancels in the ratio and the centroid
+        lambda P, F, V: rescaled(P, F, V).tolist(),  # a list of rows
+    ],
+)
+def test_the_volume_kept_passes_correct_variants(fn):
+    result = check.volume_kept.evaluate(fn, seed=4)
+    assert result.passed and "icosphere" in result.message, result.message
+
+
+VOLUME_LEARNERS = {
+    "the volume ratio itself": lambda P, F, V: rescaled(P, F, V, cube=False),
+    "not moved back": lambda P, F, V: rescaled(P, F, V, back=False),
+    "means of the vertices": lambda P, F, V: rescaled(P, F, V, about_solid=False),
+    "the fourth corner, the origin, is left out": lambda P, F, V: rescaled(P, F, V, corner=3.0),
+    "returned as it came": lambda P, F, V: P,
+}
+
+
+@pytest.mark.parametrize("name", VOLUME_LEARNERS)
+def test_each_volume_mistake_written_by_hand_is_named(name):
+    result = check.volume_kept.evaluate(VOLUME_LEARNERS[name], seed=5)
+    assert not result.passed and result.partial and name in result.message, result.message
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("entry", [e for e in VOLUME_MISTAKES if e.build is not None], ids=repr)
+def test_every_wrong_rescaling_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    from diagnoses import replaying
+
+    from geomlib.teaching.check.implicit import volume_kept_cases
+
+    result = check.volume_kept.evaluate(
+        replaying(volume_kept_cases(np.random.default_rng(seed)), entry.build), seed=seed
+    )
+    assert not result.passed and result.partial and entry.diagnosis in result.message, result.message
+
+
+def test_the_volume_kept_holds_the_volume_and_the_centroid_it_claims():
+    from geomlib.mesh.geometry import volume_and_centroid
+    from geomlib.teaching.check.meshes import placed
+
+    V, F = placed(*jittered_icosphere(), np.random.default_rng(2))
+    P = 0.8 * V + np.array([1.0, -2.0, 0.5])
+    vol0, c0 = volume_and_centroid(V, F)
+    vol, c = volume_and_centroid(rescaled(P, F, V), F)
+    assert abs(vol / vol0 - 1) < 1e-12 and np.allclose(c, c0, atol=1e-12)

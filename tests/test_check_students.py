@@ -892,6 +892,67 @@ def implicit_no_coupling(V, F, tau, N):
     return P
 
 
+# ============================================================================ 06 · volume_kept
+
+
+def _face_loop_solid(X, F, corner=4.0, signed=True):
+    """Volume and centroid of the solid, one face at a time (a student's loop)."""
+    vol, moment = 0.0, np.zeros(3)
+    for a, b, c in F:
+        v = np.dot(X[a], np.cross(X[b], X[c])) / 6.0
+        v = v if signed else abs(v)
+        vol += v
+        moment += v * (X[a] + X[b] + X[c]) / corner
+    return vol, moment / vol
+
+
+@student("volume_kept")
+def volume_face_loop(P, F, V):
+    vol0, c0 = _face_loop_solid(V, F)
+    vol, c = _face_loop_solid(P, F)
+    return c0 + (P - c) * np.cbrt(vol0 / vol)
+
+
+@student("volume_kept")
+def volume_apex_at_a_vertex(P, F, V):
+    def solid(X):
+        o = X[0]  # any apex gives the same solid; the first vertex keeps the numbers small
+        A, B, C = X[F[:, 0]] - o, X[F[:, 1]] - o, X[F[:, 2]] - o
+        v = np.linalg.det(np.stack([A, B, C], axis=1))
+        return v.sum(), o + (A + B + C).T @ v / (4 * v.sum())
+
+    (vol0, c0), (vol, c) = solid(V), solid(P)
+    return (P - c) * (vol0 / vol) ** (1 / 3) + c0
+
+
+@student("volume_kept", named="the volume ratio itself")
+def volume_no_cube_root(P, F, V):
+    vol0, c0 = _face_loop_solid(V, F)
+    vol, c = _face_loop_solid(P, F)
+    return c0 + (P - c) * (vol0 / vol)
+
+
+@student("volume_kept", named="means of the vertices")
+def volume_vertex_means(P, F, V):
+    vol0, _ = _face_loop_solid(V, F)
+    vol, _ = _face_loop_solid(P, F)
+    return V.mean(axis=0) + (P - P.mean(axis=0)) * np.cbrt(vol0 / vol)
+
+
+@student("volume_kept", named="absolute values")
+def volume_abs_tetrahedra(P, F, V):
+    vol0, c0 = _face_loop_solid(V, F, signed=False)
+    vol, c = _face_loop_solid(P, F, signed=False)
+    return c0 + (P - c) * np.cbrt(vol0 / vol)
+
+
+@student("volume_kept", named="not moved back")
+def volume_stays_put(P, F, V):
+    vol0, _ = _face_loop_solid(V, F)
+    vol, c = _face_loop_solid(P, F)
+    return c + (P - c) * np.cbrt(vol0 / vol)
+
+
 # ============================================================================ 07 · add_noise
 
 
@@ -1357,7 +1418,7 @@ def verdict(exercise, fn):
 def test_the_corpus_covers_every_auto_graded_exercise():
     auto_graded = {
         "uniform_laplacian", "gaussian_curvature", "fundamental_forms", "normal_curvature", "cotangent_matrix",
-        "mixed_areas", "eigenpairs", "spectral_reconstruction", "lam_max", "smoothing_loop", "implicit_loop",
+        "mixed_areas", "eigenpairs", "spectral_reconstruction", "lam_max", "smoothing_loop", "implicit_loop", "volume_kept",
         "add_noise", "vertex_rms", "denoising_experiment", "denoising_sweep",
     }  # fmt: skip
     assert set(EXERCISES) == auto_graded

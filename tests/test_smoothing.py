@@ -17,6 +17,7 @@ from geomlib.lessons.smoothing import (
     fixed_point,
     highest_frequency_mode,
     implicit_step,
+    volume_rescaled,
 )
 from geomlib.mesh.geometry import volume_and_centroid
 from geomlib.mesh.topology import boundary_vertices
@@ -735,3 +736,13 @@ def test_an_unknown_option_names_the_option_the_value_and_the_choices():
         implicit_smoothing(V, F, 0.1, 1, boundary_condition="clamped")
     with pytest.raises(MeshError, match=r"solver must be one of 'cholesky', 'cg', not 'lu'"):
         implicit_smoothing(V, F, 0.1, 1, solver="lu")
+
+
+def test_volume_rescaled_gives_back_the_volume_and_centroid_of_the_reference():
+    V, F = icosphere(2, centre=(2.0, 1.0, -3.0))
+    P = 0.7 * V @ np.diag([1.0, 0.9, 1.1]) + np.array([0.3, -1.0, 2.0])
+    vol0, c0 = volume_and_centroid(V, F)
+    vol, c = volume_and_centroid(volume_rescaled(P, F, V), F)
+    assert abs(vol / vol0 - 1) < 1e-12 and np.allclose(c, c0, atol=1e-12)
+    with pytest.raises(MeshError, match="enclosed volume became"):
+        volume_rescaled(np.zeros_like(V), F, V)

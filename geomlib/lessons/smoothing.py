@@ -58,6 +58,7 @@ __all__ = [
     "explicit_step_limit",
     "highest_frequency_mode",
     "fixed_point",
+    "volume_rescaled",
     "ExplicitSmoother",
     "ImplicitSmoother",
 ]
@@ -522,9 +523,26 @@ class _Collapse(Exception):
     pass
 
 
+def volume_rescaled(P, F, V):
+    """P scaled about the centroid of the solid it encloses by ``(vol(V) / vol(P))^(1/3)`` and moved to V's centroid.
+
+    The volume rescaling of Desbrun et al. 1999 (``keep_volume=True``): the result
+    encloses V's volume and its solid's centroid is V's. Volumes and centroids by the
+    divergence theorem (:func:`geomlib.mesh.geometry.volume_and_centroid`), so F must be
+    closed and counter-clockwise seen from outside. P, V: (n, 3) positions in the same
+    length units; returns a new (n, 3) array. Raises MeshError when P encloses no
+    positive volume.
+    """
+    vol0, c0 = volume_and_centroid(V, F)
+    vol, c = volume_and_centroid(P, F)
+    if not (vol > 0 and np.isfinite(vol)):
+        raise MeshError(f"the enclosed volume became {vol:.6g}: nothing to rescale")
+    return c0 + (P - c) * (vol0 / vol) ** (1.0 / 3.0)
+
+
 class _VolumeKeeper:
     """Rescale about the centroid so that the enclosed volume and its centroid stay
-    those of the start (the volume rescaling of Desbrun et al. 1999)."""
+    those of the start (:func:`volume_rescaled`)."""
 
     def __init__(self, P, F):
         b = boundary_vertices(F, len(P))
@@ -533,8 +551,8 @@ class _VolumeKeeper:
                 "keep_volume needs a closed mesh (the enclosed volume of an open mesh "
                 f"is undefined); boundary vertices: {format_indices(b)}"
             )
-        self.F = F
-        self.vol0, self.c0 = volume_and_centroid(P, F)
+        self.F, self.V0 = F, np.array(P, dtype=np.float64)
+        self.vol0 = volume_and_centroid(P, F)[0]
         if not self.vol0 > 0:
             raise MeshError(
                 f"keep_volume: the enclosed volume is {self.vol0:.6g}, not positive "
@@ -542,10 +560,10 @@ class _VolumeKeeper:
             )
 
     def __call__(self, P, k):
-        vol, c = volume_and_centroid(P, self.F)
-        if not (vol > 0 and np.isfinite(vol)):
-            raise _Collapse(f"the enclosed volume became {vol:.6g} at iteration {k}")
-        return self.c0 + (P - c) * (self.vol0 / vol) ** (1.0 / 3.0)
+        try:
+            return volume_rescaled(P, self.F, self.V0)
+        except MeshError as exc:
+            raise _Collapse(f"{exc} at iteration {k}") from None
 
 
 def _rebuilt_step(P, F, weights, area, boundary_condition, tau, k):

@@ -81,77 +81,27 @@ def cotangent_cases(rng):
     return [cotangent_case(c.label, c.V, c.F) for c in mesh_cases(_MESHES, rng)]
 
 
+# fmt: off
 C_MISTAKES = [
     Wrong("the sign of C is flipped", _RULE + ", so that C is negative semidefinite", build=lambda c: -c.C),
     Wrong("the factor 1/2 is missing: every weight is twice the right one", _RULE, build=lambda c: 2 * c.C),
-    Wrong(
-        "every weight is half the right one: the 1/2 applied twice, or Heron's 1/4 written 1/2",
-        "A = 1/4 sqrt((a + b + c)(-a + b + c)(a - b + c)(a + b - c)); C_jk = 1/2 (cot alpha + cot beta)",
-        build=lambda c: c.C / 2,
-    ),
-    Wrong(
-        "every weight is a quarter of the right one: Heron's formula without its 1/4",
-        "A = 1/4 sqrt((a + b + c)(-a + b + c)(a - b + c)(a + b - c))",
-        build=lambda c: c.C / 4,
-    ),
-    Wrong(
-        "Heron's formula is used with the perimeter instead of the half-perimeter s",
-        "A = sqrt(s (s - a)(s - b)(s - c)) with s = (a + b + c) / 2",
-        build=lambda c: _assemble(c, 0.5 * _cot(c, A=_perimeter_heron(c))),
-    ),
-    Wrong(
-        "the diagonal of C is missing (its rows do not sum to zero)",
-        "set C_ii = -sum of C_ij over the neighbours j of i",
-        build=lambda c: c.C - np.diag(np.diag(c.C)),
-    ),
+    Wrong("every weight is half the right one: the 1/2 applied twice, or Heron's 1/4 written 1/2", "A = 1/4 sqrt((a + b + c)(-a + b + c)(a - b + c)(a + b - c)); C_jk = 1/2 (cot alpha + cot beta)", build=lambda c: c.C / 2),
+    Wrong("every weight is a quarter of the right one: Heron's formula without its 1/4", "A = 1/4 sqrt((a + b + c)(-a + b + c)(a - b + c)(a + b - c))", build=lambda c: c.C / 4),
+    Wrong("Heron's formula is used with the perimeter instead of the half-perimeter s", "A = sqrt(s (s - a)(s - b)(s - c)) with s = (a + b + c) / 2", build=lambda c: _assemble(c, 0.5 * _cot(c, A=_perimeter_heron(c)))),
+    Wrong("the diagonal of C is missing (its rows do not sum to zero)", "set C_ii = -sum of C_ij over the neighbours j of i", build=lambda c: c.C - np.diag(np.diag(c.C))),
     *(Wrong(*_ENDS, build=lambda c, end=end: _assemble(c, 0.5 * c.cot[:, end])) for end in (NEXT, PREV)),
-    Wrong(
-        "the law of cosines is written with the lengths, not their squares",
-        "cos theta_i = (l_j^2 + l_k^2 - l_i^2) / (2 l_j l_k), so cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)",
-        build=lambda c: _assemble(c, 0.5 * _cot(c, squares=False)),
-    ),
-    Wrong(
-        "cos theta is used, not cot theta",
-        "cot = cos / sin, and sin theta_i = 2 A / (l_j l_k): cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)",
-        build=lambda c: _assemble(c, 0.5 * c.cot * (4 * c.A[:, None]) / (2 * c.l[:, NEXT] * c.l[:, PREV])),
-    ),
+    Wrong("the law of cosines is written with the lengths, not their squares", "cos theta_i = (l_j^2 + l_k^2 - l_i^2) / (2 l_j l_k), so cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)", build=lambda c: _assemble(c, 0.5 * _cot(c, squares=False))),
+    Wrong("cos theta is used, not cot theta", "cot = cos / sin, and sin theta_i = 2 A / (l_j l_k): cot theta_i = (l_j^2 + l_k^2 - l_i^2) / (4 A)", build=lambda c: _assemble(c, 0.5 * c.cot * (4 * c.A[:, None]) / (2 * c.l[:, NEXT] * c.l[:, PREV]))),
     Wrong("tan is used instead of cot", "cot theta = cos theta / sin theta = 1 / tan theta", build=lambda c: _tan(c)),
-    Wrong(
-        "the angles are in degrees where np.tan expects radians",
-        "np.arccos returns radians: 1 / np.tan(theta) as it is, or the law of cosines over 4 A",
-        build=lambda c: _assemble(c, 0.5 / np.tan(np.degrees(np.arctan2(1.0, c.cot)))),
-    ),
-    Wrong(
-        "boundary edges are left out: an edge with one triangle gets no weight",
-        "a boundary edge gets 1/2 cot of the one angle opposite it (the natural boundary condition)",
-        build=lambda c: _boundary(c, 0.0),
-    ),
-    Wrong(
-        "boundary edges get cot of their one opposite angle, without the 1/2",
-        "C_jk = 1/2 (cot alpha + cot beta); a boundary edge has only alpha: 1/2 cot alpha",
-        build=lambda c: _boundary(c, 2.0),
-    ),
-    Wrong(
-        "the rows of the boundary vertices are zeroed: a boundary rule built into C",
-        "this exercise asks for the operator itself: a boundary vertex keeps its row, a boundary edge 1/2 cot alpha",
-        build=lambda c: np.where(c.on_boundary[:, None], 0.0, c.C),
-    ),
-    Wrong(
-        "these are the uniform weights (1 for every edge), not the cotangent weights",
-        _RULE,
-        build=lambda c: _assemble(c, np.ones(c.F.shape) / 2),
-    ),
-    Wrong(
-        "each weight is entered at C_jk only, not also at C_kj: C is not symmetric",
-        "add 1/2 cot theta_i to both C_jk and C_kj",
-        build=lambda c: _assemble(c, 0.5 * c.cot, both=False),
-    ),
-    Wrong(
-        "C is not symmetric",
-        "add each triangle's weight to both C_jk and C_kj",
-        when=lambda C, right, c: not np.allclose(C, C.T, atol=1e-9 * np.abs(right).max()),
-    ),
+    Wrong("the angles are in degrees where np.tan expects radians", "np.arccos returns radians: 1 / np.tan(theta) as it is, or the law of cosines over 4 A", build=lambda c: _assemble(c, 0.5 / np.tan(np.degrees(np.arctan2(1.0, c.cot))))),
+    Wrong("boundary edges are left out: an edge with one triangle gets no weight", "a boundary edge gets 1/2 cot of the one angle opposite it (the natural boundary condition)", build=lambda c: _boundary(c, 0.0)),
+    Wrong("boundary edges get cot of their one opposite angle, without the 1/2", "C_jk = 1/2 (cot alpha + cot beta); a boundary edge has only alpha: 1/2 cot alpha", build=lambda c: _boundary(c, 2.0)),
+    Wrong("the rows of the boundary vertices are zeroed: a boundary rule built into C", "this exercise asks for the operator itself: a boundary vertex keeps its row, a boundary edge 1/2 cot alpha", build=lambda c: np.where(c.on_boundary[:, None], 0.0, c.C)),
+    Wrong("these are the uniform weights (1 for every edge), not the cotangent weights", _RULE, build=lambda c: _assemble(c, np.ones(c.F.shape) / 2)),
+    Wrong("each weight is entered at C_jk only, not also at C_kj: C is not symmetric", "add 1/2 cot theta_i to both C_jk and C_kj", build=lambda c: _assemble(c, 0.5 * c.cot, both=False)),
+    Wrong("C is not symmetric", "add each triangle's weight to both C_jk and C_kj", when=lambda C, right, c: not np.allclose(C, C.T, atol=1e-9 * np.abs(right).max())),
 ]
+# fmt: on
 
 
 def _square(out, n):

@@ -123,9 +123,9 @@ NOISE_MISTAKES = [
     Wrong('sigma is used as a variance: the standard deviation came out as sigma^2 * d', 'sigma is the standard deviation; draw standard normals and multiply by sigma * d', when=_std_is(lambda c: _SIGMA ** 2 * c.d)),
     Wrong('the variance s^2 is used where the standard deviation s belongs', 'multiply standard normal numbers by s = sigma * d, not by s^2', when=_std_is(lambda c: (_SIGMA * c.d) ** 2)),
     Wrong('the square root of s is used: sigma * d was taken as a variance', 'the standard deviation is s = sigma * d itself', when=_std_is(lambda c: np.sqrt(_SIGMA * c.d))),
-    Wrong('each displacement has length about s (a random direction scaled to s), so each coordinate moves by only s / sqrt(3)', 'draw each of the three coordinates independently with standard deviation s', when=_std_is(lambda c: _SIGMA * c.d / np.sqrt(3))),
-    Wrong('the standard deviation per coordinate differs from s = sigma * d', 'multiply standard normal numbers by sigma times the bounding-box diagonal of V', when=lambda a, s, c: not _near(a.std, s), typical=False),
+    Wrong('each displacement has length about s (a random direction scaled to s), so each coordinate moves by only s / sqrt(3)', 'draw each of the three coordinates independently with standard deviation s', when=lambda a, s, c: _std_is(lambda c: s / np.sqrt(3))(a, s, c) and np.ptp(np.linalg.norm(a.D, axis=1)) <= 1e-6 * c.d),
     Wrong('the noise is not Gaussian (a normal distribution has kurtosis 3, a uniform one 1.8)', 'use rng.standard_normal, not rng.random or rng.uniform', when=lambda a, s, c: a.kurtosis < 2.5),
+    Wrong('the standard deviation per coordinate differs from s = sigma * d', 'multiply standard normal numbers by sigma times the bounding-box diagonal of V', when=lambda a, s, c: not _near(a.std, s), typical=False),
 ]
 # fmt: on
 
@@ -233,7 +233,12 @@ def _run(sigma, tau, iterations, directions=False):
     X = np.random.default_rng(_EXP_SEED).standard_normal(V.shape)
     W = V + sigma * d * X / np.linalg.norm(X, axis=1, keepdims=True) if directions else noise(V, F, sigma, _EXP_SEED)
     P = implicit_smoothing(W, F, tau, iterations)
-    return {"right": _rms(P, V) / d, "noisy": _rms(P, W) / d, "noise": _rms(W, V) / d}
+    return {
+        "right": _rms(P, V) / d,
+        "noisy": _rms(P, W) / d,
+        "noisy d": _rms(P, W) / bounding_box_diagonal(W),
+        "noise": _rms(W, V) / d,
+    }
 
 
 def _experiment_cases():
@@ -268,6 +273,7 @@ EXPERIMENT_MISTAKES = [
     _scalar('the error is sqrt(3) too small (its square a third of the right one): the mean runs over the 3n coordinates instead of the n vertices', 'average |p_i - x_i|^2 over the n vertices', lambda c: _e(c) / np.sqrt(3)),
     _scalar('the noise is sqrt(3) too small (its square a third of the right one): each vertex moved by a random direction of length sigma * d, so each coordinate moves by only sigma * d / sqrt(3)', 'draw every coordinate with standard deviation sigma * d', lambda c: _e(c, directions=True)),
     _scalar('the error is measured against the noisy mesh (the input of the smoothing), not against the clean mesh, the truth', 'return the RMS distance between the smoothed mesh and V_clean', lambda c: _e(c, key='noisy')),
+    _scalar('the error is measured against the noisy mesh W (as my_vertex_rms(P, W)), not against the clean mesh, the truth', 'return my_vertex_rms(P, V_clean): the smoothed mesh against V_clean', lambda c: _e(c, key='noisy d')),
     _scalar('the error is that of the noisy mesh: the smoothed mesh is not the one measured', 'smooth the noisy mesh and measure the result against V_clean', lambda c: _e(c, key='noise')),
     _scalar('the clean mesh was smoothed instead of the noisy one', 'smooth W = V_clean + noise, then compare with V_clean', lambda c: _e(c, sigma=0.0)),
     Wrong("on {label} the error differs from geomlib's run (by more than 5 %, or at all without noise)", 'smooth with geomlib.implicit_smoothing(W, F, tau, iterations) (cotangent weights)', typical=False),

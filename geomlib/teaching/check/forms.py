@@ -1,25 +1,48 @@
 """Checks of notebook 02: the ellipsoid's fundamental forms, and kappa_n from whatever forms it is handed.
 
-``fundamental_forms`` compares the learner's expressions by value (an unsimplified answer passes) at points
-drawn each run on three ellipsoids with F != 0, against p's derivatives written out with numpy.
-``normal_curvature`` hands the learner's function the forms of the ellipsoid (at (a, 0, 0) and at a generic
-point) and of a Monge patch with F and f non-zero, so that a function which ignores the forms, or drops a
-mixed term, is told apart. sympy is imported inside the checks (a second to import; most notebooks need none).
+``fundamental_forms`` compares the learner's expressions by value (unsimplified passes) at points drawn each run
+on three ellipsoids with F != 0; ``normal_curvature`` hands the learner's function the forms of the ellipsoid (at
+(a, 0, 0) and a generic point) and of a Monge patch with F, f != 0, so that ignoring the forms is told apart.
 """
 
 import functools
 
 import numpy as np
 
-from .catalogue import Case, Wrong, judge, number
+from .catalogue import Case, Wrong, answer, judge, number
 from .result import Mistake, call, case_rng, exercise
 
 __all__ = ["fundamental_forms", "normal_curvature"]
 
 _PAIR = "return the pair (I, II): I = Matrix([[E, F], [F, G]]), II = Matrix([[e, f], [f, g]])"
+_SURFACES = ("lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid")  # forbidden in both exercises
+_OWN = ("lessons.symbolic.forms_normal_curvature", "lessons.symbolic.unit_tangent")
 
 
-# ------------------------------------------------------------------------------------ fundamental_forms
+@functools.lru_cache(maxsize=None)
+def _surface(kind):
+    """A surface of the check: its forms function (a, b, c, u, v) -> (I, II), symbols or numbers in (II against
+    p_u x p_v / |.|), its own symbols a, b, c, u, v, and its E, F, G, e, f, g in them."""
+    import sympy as sp
+
+    own = a, b, c, u, v = sp.symbols("a b c u v", real=True)
+    if kind == "ellipsoid":
+        p = sp.Matrix([a * sp.cos(u) * sp.sin(v), b * sp.sin(u) * sp.sin(v), c * sp.cos(v)])
+    else:  # a Monge patch z = h(u, v) with h_u h_v != 0 (so F != 0) and h_uv != 0 (so f != 0)
+        p = sp.Matrix([u, v, c * sp.sin(u / a) * sp.cos(v / b) + u * v / (a + b)])
+    p_u, p_v = p.diff(u), p.diff(v)
+    unit = p_u.cross(p_v).normalized()
+    I = sp.Matrix([[p_u.dot(p_u), p_u.dot(p_v)], [p_u.dot(p_v), p_v.dot(p_v)]])
+    II = sp.Matrix(2, 2, lambda i, j: p.diff(own[3 + i], own[3 + j]).dot(unit))
+
+    def forms(*at):
+        where = dict(zip(own, at))
+        return I.subs(where, simultaneous=True), II.subs(where, simultaneous=True)
+
+    forms.__name__ = f"{kind}_forms"
+    return forms, own, _coefficients((I, II))
+
+
 def _coefficients(out):
     """The six expressions (E, F, G, e, f, g) from the pair of 2x2 matrices (I, II), or from six expressions."""
     import sympy as sp
@@ -34,12 +57,12 @@ def _coefficients(out):
     raise Mistake(f"the function returned {type(out).__name__}, not the pair (I, II)", _PAIR, typical=False)
 
 
-def _values(exprs, symbols, points):
-    """(6, len(points)) float array of the expressions at the points (a, b, c, u, v)."""
+def _values(exprs, symbols, points, learner=True):
+    """(6, k) float values of the expressions at the k points (a, b, c, u, v); the learner's must be real."""
     import sympy as sp
 
     extra = set().union(*(x.free_symbols for x in exprs)) - set(symbols)
-    if extra:
+    if learner and extra:
         raise Mistake(
             f"the expressions contain symbols other than a, b, c, u, v: {sorted(map(str, extra))}",
             "build p(u, v) from the symbols the function receives as arguments, not new ones",
@@ -47,7 +70,7 @@ def _values(exprs, symbols, points):
     f = sp.lambdify(symbols, exprs, modules="numpy")
     with np.errstate(all="ignore"):
         vals = np.array([np.broadcast_to(np.asarray(f(*pt), dtype=complex), 6) for pt in points]).T
-    if not np.all(np.isfinite(vals)) or np.abs(vals.imag).max() > 1e-9 * (1 + np.abs(vals.real).max()):
+    if learner and not np.all(np.isfinite(vals)) or np.abs(vals.imag).max() > 1e-9 * (1 + np.abs(vals.real).max()):
         raise Mistake(
             "the expressions are not real numbers at points inside the domain",
             "check square roots and divisions: 0 < v < pi, a, b, c > 0",
@@ -56,39 +79,16 @@ def _values(exprs, symbols, points):
     return vals.real
 
 
-def _reference(points):
-    """(6, k) E, F, G, e, f, g of the ellipsoid at the points (a, b, c, u, v), from p's derivatives written out,
-    and |p_u x p_v| (k,): the workbook's II takes -n = p_u x p_v / |p_u x p_v|."""
-    a, b, c, u, v = points.T
-    cu, su, cv, sv, zero = np.cos(u), np.sin(u), np.cos(v), np.sin(v), 0 * u
-    p_u, p_v = np.stack([-a * su * sv, b * cu * sv, zero], 1), np.stack([a * cu * cv, b * su * cv, -c * sv], 1)
-    p_uu, p_uv = np.stack([-a * cu * sv, -b * su * sv, zero], 1), np.stack([-a * su * cv, b * cu * cv, zero], 1)
-    p_vv = np.stack([-a * cu * sv, -b * su * sv, -c * cv], 1)
-    m = np.cross(p_u, p_v)
-    cross = np.linalg.norm(m, axis=1)
-    dot = lambda x, y: np.einsum("ij,ij->i", x, y)  # noqa: E731
-    pairs = ((p_u, p_u), (p_u, p_v), (p_v, p_v), (p_uu, m), (p_uv, m), (p_vv, m))
-    return np.array([dot(x, y) for x, y in pairs]) / np.vstack(
-        [np.ones((3, len(cross))), np.tile(cross, (3, 1))]
-    ), cross
+def _at(kind, points, label, **inputs):
+    """A case at k points (a, b, c, u, v): right (6, k) E..g there, at_swapped at (v, u), cross = sqrt(EG - F^2)."""
+    _, own, exprs = _surface(kind)
+    uv, vu = (_values(exprs, own, at, learner=False) for at in (points, points[:, [0, 1, 2, 4, 3]]))
+    return Case(label, **inputs).but(points=points, right=uv, at_swapped=vu, cross=np.sqrt(uv[0] * uv[2] - uv[1] ** 2))
 
 
-def _forms_case(label, points):
-    right, cross = _reference(points)
-    swapped, _ = _reference(points[:, [0, 1, 2, 4, 3]])  # the true forms at (v, u)
-    return Case(label, points=points).but(right=right, cross=cross, at_swapped=swapped)
-
-
-_FIRST, _SECOND = [0, 1, 2], [3, 4, 5]
-
-
-def _with(c, first=None, second=None):
-    out = c.right.copy()
-    if first is not None:
-        out[_FIRST] = first
-    if second is not None:
-        out[_SECOND] = second
-    return out
+def _times(X, first=1.0, second=1.0):
+    """X (6, k) with E, F, G multiplied by ``first`` and e, f, g by ``second``."""
+    return np.vstack([X[:3] * first, X[3:] * second])
 
 
 def _same_factor(got, right):
@@ -98,96 +98,46 @@ def _same_factor(got, right):
     return bool(usable.any() and np.allclose(ratio, ratio[0], rtol=1e-7) and not np.isclose(ratio[0], 1.0))
 
 
+_UV = [2, 1, 0, 5, 4, 3]  # E, F, G, e, f, g with the roles of u and v exchanged
+
+# fmt: off
 FORMS_MISTAKES = [
-    Wrong(
-        "u and v are swapped: u is taken as the polar angle and v as the longitude",
-        "p(u, v) = (a cos u sin v, b sin u sin v, c cos v): u turns around the z axis, v runs from the north "
-        "pole (v = 0) to the south pole (v = pi)",
-        # the learner's p(u, v) is the true p(v, u): its p_u is the true p_v, and p_u x p_v turns round
-        build=lambda c: c.at_swapped[[2, 1, 0, 5, 4, 3]] * np.array([[1], [1], [1], [-1], [-1], [-1]]),
-    ),
-    Wrong(
-        "u and v are exchanged: the forms come out at the point (v, u) (the parameters taken in the wrong order)",
-        "the function receives a, b, c, u, v in this order; p(u, v) = (a cos u sin v, b sin u sin v, c cos v)",
-        build=lambda c: c.at_swapped,
-    ),
-    Wrong(
-        "E and G are exchanged (and e and g): the derivatives in u and v are swapped",
-        "E = p_u . p_u and e = -p_uu . n, with p_u = dp/du; u is the longitude, v the polar angle",
-        build=lambda c: c.right[[2, 1, 0, 5, 4, 3]],
-    ),
-    Wrong(
-        "E and G are exchanged",
-        "E = p_u . p_u with p_u = dp/du, G = p_v . p_v",
-        build=lambda c: _with(c, first=c.right[[2, 1, 0]]),
-    ),
-    Wrong(
-        "F has the wrong sign",
-        "F = p_u . p_v, the dot product of the two tangents as they are",
-        build=lambda c: _with(c, first=c.right[_FIRST] * np.array([[1], [-1], [1]])),
-    ),
-    Wrong(
-        "E and G are the lengths |p_u|, |p_v|, not their squares",
-        "E = p_u . p_u = |p_u|^2, G = p_v . p_v = |p_v|^2",
-        build=lambda c: _with(c, first=[np.sqrt(c.right[0]), c.right[1], np.sqrt(c.right[2])]),
-    ),
-    Wrong(
-        "the sign of the normal is flipped: e, f, g are all negated",
-        "the workbook's II uses the inward normal -n = p_u x p_v / |p_u x p_v| on this ellipsoid, so that every "
-        "curvature of a convex surface is positive",
-        build=lambda c: _with(c, second=-c.right[_SECOND]),
-    ),
-    Wrong(
-        "the normal is not normalised: e, f, g are multiplied by |p_u x p_v|",
-        "divide p_u x p_v by its length before dotting it with p_uu, p_uv, p_vv",
-        build=lambda c: _with(c, second=c.right[_SECOND] * c.cross),
-    ),
-    Wrong(
-        "the normal is not normalised and its sign is flipped: e, f, g are multiplied by -|p_u x p_v|",
-        "-n = p_u x p_v / |p_u x p_v|: a unit vector, pointing inwards on this ellipsoid",
-        build=lambda c: _with(c, second=-c.right[_SECOND] * c.cross),
-    ),
-    Wrong(
-        "the normal is divided by |p_u x p_v| twice: e, f, g are divided by |p_u x p_v|",
-        "-n = p_u x p_v / |p_u x p_v|, divided once",
-        build=lambda c: _with(c, second=c.right[_SECOND] / c.cross),
-    ),
-    Wrong(
-        "e, f, g are all off by the same factor: the normal is not a unit vector",
-        "-n = p_u x p_v / |p_u x p_v|, a unit vector",
-        when=lambda answer, right, c: _same_factor(answer[_SECOND], right[_SECOND]),
-    ),
-    Wrong(
-        "e and g are exchanged: the second derivatives in u and v are swapped",
-        "e = -p_uu . n, f = -p_uv . n, g = -p_vv . n",
-        build=lambda c: _with(c, second=c.right[[5, 4, 3]]),
-    ),
-    Wrong(
-        "F is left out (taken as 0): p_u and p_v are perpendicular only on the coordinate planes",
-        "F = p_u . p_v, which is not 0 at a generic point of an ellipsoid with a != b",
-        build=lambda c: _with(c, first=[c.right[0], 0 * c.right[1], c.right[2]]),
-    ),
+    # the learner's p(u, v) is the true p(v, u): its p_u is the true p_v, and p_u x p_v turns round
+    Wrong("u and v are swapped: u is taken as the polar angle and v as the longitude", "p(u, v) = (a cos u sin v, b sin u sin v, c cos v): u turns around the z axis, v runs from the north pole (v = 0) to the south pole (v = pi)", build=lambda c: _times(c.at_swapped[_UV], second=-1)),
+    Wrong("u and v are exchanged: the forms come out at the point (v, u) (the parameters taken in the wrong order)", "the function receives a, b, c, u, v in this order; p(u, v) = (a cos u sin v, b sin u sin v, c cos v)", build=lambda c: c.at_swapped),
+    Wrong("E and G are exchanged (and e and g): the derivatives in u and v are swapped", "E = p_u . p_u and e = -p_uu . n, with p_u = dp/du; u is the longitude, v the polar angle", build=lambda c: c.right[_UV]),
+    Wrong("E and G are exchanged", "E = p_u . p_u with p_u = dp/du, G = p_v . p_v", build=lambda c: c.right[[2, 1, 0, 3, 4, 5]]),
+    Wrong("F has the wrong sign", "F = p_u . p_v, the dot product of the two tangents as they are", build=lambda c: _times(c.right, first=[[1], [-1], [1]])),
+    Wrong("E and G are the lengths |p_u|, |p_v|, not their squares", "E = p_u . p_u = |p_u|^2, G = p_v . p_v = |p_v|^2", build=lambda c: c.right ** [[0.5], [1], [0.5], [1], [1], [1]]),
+    Wrong("the sign of the normal is flipped: e, f, g are all negated", "the workbook's II uses the inward normal -n = p_u x p_v / |p_u x p_v| on this ellipsoid, so that every curvature of a convex surface is positive", build=lambda c: _times(c.right, second=-1)),
+    Wrong("the normal is not normalised: e, f, g are multiplied by |p_u x p_v|", "divide p_u x p_v by its length before dotting it with p_uu, p_uv, p_vv", build=lambda c: _times(c.right, second=c.cross)),
+    Wrong("the normal is not normalised and its sign is flipped: e, f, g are multiplied by -|p_u x p_v|", "-n = p_u x p_v / |p_u x p_v|: a unit vector, pointing inwards on this ellipsoid", build=lambda c: _times(c.right, second=-c.cross)),
+    Wrong("the normal is divided by |p_u x p_v| twice: e, f, g are divided by |p_u x p_v|", "-n = p_u x p_v / |p_u x p_v|, divided once", build=lambda c: _times(c.right, second=1 / c.cross)),
+    Wrong("e, f, g are all off by the same factor: the normal is not a unit vector", "-n = p_u x p_v / |p_u x p_v|, a unit vector", when=lambda answer, right, c: _same_factor(answer[3:], right[3:])),
+    Wrong("e and g are exchanged: the second derivatives in u and v are swapped", "e = -p_uu . n, f = -p_uv . n, g = -p_vv . n", build=lambda c: c.right[[0, 1, 2, 5, 4, 3]]),
+    Wrong("F is left out (taken as 0): p_u and p_v are perpendicular only on the coordinate planes", "F = p_u . p_v, which is not 0 at a generic point of an ellipsoid with a != b", build=lambda c: _times(c.right, first=[[1], [0], [1]])),
 ]
+# fmt: on
 
 
 def forms_cases(rng):
     """Three ellipsoids with different semi-axes (a != b, so F != 0), two points each, drawn with ``rng``."""
     cases = []
     for k in range(3):
-        axes = np.sort(rng.uniform(0.4, 2.5, size=3))[rng.permutation(3)]
+        axes = np.zeros(3)
         while np.min(np.abs(np.diff(np.sort(axes)))) < 0.15:  # three clearly different semi-axes
             axes = np.sort(rng.uniform(0.4, 2.5, size=3))[rng.permutation(3)]
         u = rng.uniform(0.2, 1.3, size=2) + rng.integers(0, 4, size=2) * np.pi / 2  # away from sin 2u = 0
         v = rng.uniform(0.25, 1.3, size=2) + rng.integers(0, 2, size=2) * (np.pi / 2 - 0.1)
         points = np.column_stack([np.tile(axes, (2, 1)), u, v])
-        cases.append(_forms_case(f"the ellipsoid with semi-axes {', '.join(f'{x:.2f}' for x in axes)}", points))
+        cases.append(_at("ellipsoid", points, f"the ellipsoid with semi-axes {', '.join(f'{x:.2f}' for x in axes)}"))
     return cases
 
 
 @exercise(
     "fundamental_forms",
     reread="The definitions and Steps 1-2 · the tangents p_u, p_v and the inward normal p_u x p_v / |p_u x p_v| = -n",
-    forbid=("lessons.symbolic.ellipsoid_forms", "lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid"),
+    forbid=("lessons.symbolic.ellipsoid_forms", *_SURFACES),
     tools=("sympy", "numpy", "scipy"),
 )
 def fundamental_forms(fn):
@@ -195,141 +145,50 @@ def fundamental_forms(fn):
     import sympy as sp
 
     symbols = sp.symbols("a b c", positive=True) + sp.symbols("u v", real=True)
-    exprs = _coefficients(call(fn, *symbols))
-    cases = forms_cases(case_rng())
+    exprs, cases = _coefficients(call(fn, *symbols)), forms_cases(case_rng())
     answers = [_values(exprs, symbols, c.points) for c in cases]
     judge(FORMS_MISTAKES, cases, answers, right=lambda c: c.right)
     return ["E, F, G, e, f, g at two generic points (F != 0) of three ellipsoids"]
 
 
-# ------------------------------------------------------------------------------------ normal_curvature
-@functools.lru_cache(maxsize=None)
-def _surface(kind):
-    """(symbols, I, II) of a surface of the check, in its own symbols a, b, c, u, v (II against p_u x p_v / |.|)."""
-    import sympy as sp
-
-    a, b, c, u, v = sp.symbols("a b c u v", real=True)
-    if kind == "ellipsoid":
-        p = sp.Matrix([a * sp.cos(u) * sp.sin(v), b * sp.sin(u) * sp.sin(v), c * sp.cos(v)])
-    else:  # a Monge patch z = h(u, v) with h_u h_v != 0 (so F != 0) and h_uv != 0 (so f != 0)
-        p = sp.Matrix([u, v, c * sp.sin(u / a) * sp.cos(v / b) + u * v / (a + b)])
-    p_u, p_v = p.diff(u), p.diff(v)
-    m = p_u.cross(p_v)
-    unit = m / sp.sqrt(m.dot(m))
-    I = sp.Matrix([[p_u.dot(p_u), p_u.dot(p_v)], [p_u.dot(p_v), p_v.dot(p_v)]])
-    second = [p.diff(u, u).dot(unit), p.diff(u, v).dot(unit), p.diff(v, v).dot(unit)]
-    II = sp.Matrix([[second[0], second[1]], [second[1], second[2]]])
-    return (a, b, c, u, v), I, II
-
-
-def _forms_of(kind):
-    """The forms function the learner's routine is handed: (I, II) in the symbols (or numbers) it is given."""
-
-    def forms(a, b, c, u, v):
-        own, I, II = _surface(kind)
-        at = dict(zip(own, (a, b, c, u, v)))
-        return I.subs(at, simultaneous=True), II.subs(at, simultaneous=True)
-
-    forms.__name__ = f"{kind}_forms"
-    return forms
-
-
-def _numbers(kind, a, b, c, u, v):
-    """E, F, G, e, f, g of the surface at the numbers (floats)."""
-    own, I, II = _surface(kind)
-    at = dict(zip(own, (a, b, c, u, v)))
-    return [float(x.evalf(subs=at)) for x in (I[0, 0], I[0, 1], I[1, 1], II[0, 0], II[0, 1], II[1, 1])]
-
-
-def _kappa(E, F, G, e, f, g, du, dv, two=2.0, divide=True):
-    II_tt = e * du**2 + two * f * du * dv + g * dv**2
-    I_tt = E * du**2 + two * F * du * dv + G * dv**2
+def _kappa(k, du, dv, two=2.0, divide=True):
+    """II(t, t) / I(t, t) (or II(t, t) alone) for the forms k = (E, F, G, e, f, g) and t = (du, dv)."""
+    E, F, G, e, f, g = k
+    II_tt, I_tt = e * du**2 + two * f * du * dv + g * dv**2, E * du**2 + two * F * du * dv + G * dv**2
     return II_tt / I_tt if divide else II_tt
 
 
-def _tangent(E, F, G, phi):
-    root_E, area = np.sqrt(E), np.sqrt(E * G - F**2)
-    return np.cos(phi) / root_E - np.sin(phi) * F / (root_E * area), np.sin(phi) * root_E / area
+def _tangent(k, phi):
+    """(du, dv) of t(phi) = cos phi p_u / |p_u| + sin phi w, w the unit tangent perpendicular to p_u."""
+    root_E, area = np.sqrt(k[0]), np.sqrt(k[0] * k[2] - k[1] ** 2)
+    return np.cos(phi) / root_E - np.sin(phi) * k[1] / (root_E * area), np.sin(phi) * root_E / area
 
 
-def _right(E, F, G, e, f, g, phi):
+def _right(k, phi):
     with np.errstate(all="ignore"):  # the forms evaluated at (v, u) may sit at a pole (E = 0)
-        return _kappa(E, F, G, e, f, g, *_tangent(E, F, G, phi))
+        return _kappa(k, *_tangent(k, phi))
 
 
-def _kappa_case(label, kind, a, b, c, u, v, phis):
-    coeffs, swapped = _numbers(kind, a, b, c, u, v), _numbers(kind, a, b, c, v, u)
-    return Case(label, a=a, b=b, c=c, u=u, v=v).but(kind=kind, phis=phis, coeffs=coeffs, swapped=swapped)
+def _on(rule, k="right"):
+    """The wrong answer ``rule(forms k of the case, phi)`` at every angle of a case."""
+    return lambda c: np.array([rule(getattr(c, k)[:, 0], phi) for phi in c.phis])
 
 
-def _on(c, rule):
-    """The wrong answer ``rule(E, F, G, e, f, g, phi)`` at every angle of case c."""
-    return np.array([rule(*c.coeffs, phi) for phi in c.phis])
-
-
+# fmt: off
 KAPPA_MISTAKES = [
-    Wrong(
-        "kappa_n is about 0 at every angle: a guard on the denominator swamps I(t, t) (1e10 where 1e-10 was meant?)",
-        "divide by I(t, t) itself; with the unit tangent t(phi) it is 1, so no guard is needed",
-        when=lambda kappa, right, c: np.abs(kappa).max() <= 1e-6 * np.abs(right).max(),
-    ),
-    Wrong(
-        "the function does not use the forms it receives: it gives the ellipsoid's kappa_n at (a, 0, 0) everywhere",
-        "call forms(a, b, c, u, v) with sympy symbols, substitute the numbers, and build kappa_n from its I and II",
-        build=lambda c: c.a * np.cos(c.phis) ** 2 / c.b**2 + c.a * np.sin(c.phis) ** 2 / c.c**2,
-    ),
-    Wrong(
-        "the sign is flipped",
-        "kappa_n = II(t, t) / I(t, t) with II as the forms give it, no minus sign",
-        build=lambda c: -_on(c, _right),
-    ),
-    Wrong(
-        "F is ignored in the tangent: (du, dv) = (cos phi / sqrt(E), sin phi / sqrt(G)) treats p_u and p_v as "
-        "perpendicular",
-        "where F != 0, p_v is not perpendicular to p_u: w, the unit tangent perpendicular to p_u, is a combination "
-        "of p_u and p_v with w . p_u = 0",
-        build=lambda c: _on(
-            c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, np.cos(p) / np.sqrt(E), np.sin(p) / np.sqrt(G))
-        ),
-    ),
-    Wrong(
-        "phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi)",
-        "phi is an angle on the surface, from p_u: t = cos phi p_u / |p_u| + sin phi w, with |p_u| = sqrt(E)",
-        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, np.cos(p), np.sin(p))),
-    ),
-    Wrong(
-        "II(t, t) is not divided by I(t, t), and t = (cos phi, sin phi) in (du, dv) is not a unit vector",
-        "kappa_n = II(t, t) / I(t, t); with the unit tangent t(phi), I(t, t) = 1",
-        build=lambda c: _on(
-            c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, np.cos(p), np.sin(p), divide=False)
-        ),
-    ),
-    Wrong(
-        "the angle turns the other way: w points away from p_v (kappa_n(phi) came out kappa_n(-phi))",
-        "w is the unit tangent perpendicular to p_u on the side of p_v: w . p_v > 0",
-        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _right(E, F, G, e, f, g, -p)),
-    ),
-    Wrong(
-        "phi is measured from p_v instead of p_u (the roles of u and v exchanged)",
-        "phi = 0 is the direction of p_u: t(0) = p_u / sqrt(E)",
-        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _right(G, F, E, g, f, e, p)),
-    ),
-    Wrong(
-        "the mixed terms lack their factor 2: I(t, t) = E du^2 + 2 F du dv + G dv^2, and II(t, t) likewise",
-        "t^T I t = E du^2 + 2 F du dv + G dv^2: F stands twice in the matrix I",
-        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _kappa(E, F, G, e, f, g, *_tangent(E, F, G, p), two=1.0)),
-    ),
-    Wrong(
-        "phi is converted from degrees, but it is already in radians",
-        "phi is in radians: use np.cos(phi), np.sin(phi) as they are",
-        build=lambda c: _on(c, lambda E, F, G, e, f, g, p: _right(E, F, G, e, f, g, np.radians(p))),
-    ),
-    Wrong(
-        "the forms are evaluated at (v, u) instead of (u, v)",
-        "substitute u for the symbol u and v for the symbol v",
-        build=lambda c: np.array([_right(*c.swapped, phi) for phi in c.phis]),
-    ),
+    Wrong("kappa_n is about 0 at every angle: a guard on the denominator swamps I(t, t) (1e10 where 1e-10 was meant?)", "divide by I(t, t) itself; with the unit tangent t(phi) it is 1, so no guard is needed", when=lambda kappa, right, c: np.abs(kappa).max() <= 1e-6 * np.abs(right).max()),
+    Wrong("the function does not use the forms it receives: it gives the ellipsoid's kappa_n at (a, 0, 0) everywhere", "call forms(a, b, c, u, v) with sympy symbols, substitute the numbers, and build kappa_n from its I and II", build=lambda c: c.a * np.cos(c.phis) ** 2 / c.b**2 + c.a * np.sin(c.phis) ** 2 / c.c**2),
+    Wrong("the sign is flipped", "kappa_n = II(t, t) / I(t, t) with II as the forms give it, no minus sign", build=_on(lambda k, p: -_right(k, p))),
+    Wrong("F is ignored in the tangent: (du, dv) = (cos phi / sqrt(E), sin phi / sqrt(G)) treats p_u and p_v as perpendicular", "where F != 0, p_v is not perpendicular to p_u: w, the unit tangent perpendicular to p_u, is a combination of p_u and p_v with w . p_u = 0", build=_on(lambda k, p: _kappa(k, np.cos(p) / np.sqrt(k[0]), np.sin(p) / np.sqrt(k[2])))),
+    Wrong("phi is measured in the (u, v) parameter plane: (du, dv) = (cos phi, sin phi)", "phi is an angle on the surface, from p_u: t = cos phi p_u / |p_u| + sin phi w, with |p_u| = sqrt(E)", build=_on(lambda k, p: _kappa(k, np.cos(p), np.sin(p)))),
+    Wrong("II(t, t) is not divided by I(t, t), and t = (cos phi, sin phi) in (du, dv) is not a unit vector", "kappa_n = II(t, t) / I(t, t); with the unit tangent t(phi), I(t, t) = 1", build=_on(lambda k, p: _kappa(k, np.cos(p), np.sin(p), divide=False))),
+    Wrong("the angle turns the other way: w points away from p_v (kappa_n(phi) came out kappa_n(-phi))", "w is the unit tangent perpendicular to p_u on the side of p_v: w . p_v > 0", build=_on(lambda k, p: _right(k, -p))),
+    Wrong("phi is measured from p_v instead of p_u (the roles of u and v exchanged)", "phi = 0 is the direction of p_u: t(0) = p_u / sqrt(E)", build=_on(lambda k, p: _right(k[_UV], p))),
+    Wrong("the mixed terms lack their factor 2: I(t, t) = E du^2 + 2 F du dv + G dv^2, and II(t, t) likewise", "t^T I t = E du^2 + 2 F du dv + G dv^2: F stands twice in the matrix I", build=_on(lambda k, p: _kappa(k, *_tangent(k, p), two=1.0))),
+    Wrong("phi is converted from degrees, but it is already in radians", "phi is in radians: use np.cos(phi), np.sin(phi) as they are", build=_on(lambda k, p: _right(k, np.radians(p)))),
+    Wrong("the forms are evaluated at (v, u) instead of (u, v)", "substitute u for the symbol u and v for the symbol v", build=_on(_right, "at_swapped")),
 ]
+# fmt: on
 
 
 def kappa_cases(rng):
@@ -337,36 +196,25 @@ def kappa_cases(rng):
     a, b, c = rng.uniform(0.6, 1.0), rng.uniform(1.1, 1.5), rng.uniform(1.6, 2.2)
     u, v = rng.uniform(0.3, 1.2), rng.uniform(0.4, 1.2)
     return [
-        _kappa_case("the ellipsoid at (a, 0, 0)", "ellipsoid", a, b, c, 0.0, np.pi / 2, phis),
-        _kappa_case(f"the ellipsoid at (u, v) = ({u:.2f}, {v:.2f}), where F != 0", "ellipsoid", a, b, c, u, v, phis),
-        _kappa_case(
-            f"a Monge patch at (u, v) = ({v:.2f}, {u:.2f}), where F and f != 0", "monge", c, b, 0.7, v, u, phis
-        ),
+        _at(kind, np.array([x]), label, forms=_surface(kind)[0], **dict(zip("abcuv", x))).but(phis=phis)
+        for label, kind, x in (
+            ("the ellipsoid at (a, 0, 0)", "ellipsoid", (a, b, c, 0.0, np.pi / 2)),
+            (f"the ellipsoid at (u, v) = ({u:.2f}, {v:.2f}), where F != 0", "ellipsoid", (a, b, c, u, v)),
+            (f"a Monge patch at (u, v) = ({v:.2f}, {u:.2f}), where F and f != 0", "monge", (c, b, 0.7, v, u)),
+        )
     ]
 
 
 @exercise(
     "normal_curvature",
     reread="Step 5 · the unit tangent t(phi) = cos phi p_u / |p_u| + sin phi w and kappa_n = II(t, t) / I(t, t)",
-    forbid=(
-        "lessons.symbolic.forms_normal_curvature",
-        "lessons.symbolic.unit_tangent",
-        "lessons.symbolic.ellipsoid_normal_curvature",
-        "lessons.symbolic.ParametricSurface",
-        "lessons.symbolic.ellipsoid",
-    ),
-    own=("lessons.symbolic.forms_normal_curvature", "lessons.symbolic.unit_tangent"),
+    forbid=(*_OWN, "lessons.symbolic.ellipsoid_normal_curvature", *_SURFACES),
+    own=_OWN,
     tools=("numpy", "scipy", "sympy"),
 )
 def normal_curvature(fn):
     """Check ``fn(forms, a, b, c, u, v, phi) -> kappa_n``: forms(a, b, c, u, v) -> (I, II) in sympy; numbers in."""
-    cases = kappa_cases(case_rng())
-    hint = "return kappa_n as one number for the given forms, a, b, c, u, v and phi"
-    answers = [
-        np.array(
-            [number(call(fn, _forms_of(c.kind), c.a, c.b, c.c, c.u, c.v, float(phi)), hint=hint) for phi in c.phis]
-        )
-        for c in cases
-    ]
-    judge(KAPPA_MISTAKES, cases, answers, right=lambda c: _on(c, _right))
+    cases, hint = kappa_cases(case_rng()), "return kappa_n as one number for the given forms, a, b, c, u, v and phi"
+    answers = [np.array([number(answer(fn, c, phi=float(phi)), hint=hint) for phi in c.phis]) for c in cases]
+    judge(KAPPA_MISTAKES, cases, answers, right=_on(_right))
     return [c.label for c in cases]
