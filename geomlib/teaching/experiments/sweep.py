@@ -30,7 +30,7 @@ from ...lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmooth
 from ...mesh.errors import MeshError, MeshWarning
 from ...mesh.geometry import bounding_box_diagonal
 from ...mesh.validate import check_choice
-from ...numerics import eigenbasis_store, experiment_store
+from ...numerics import experiment_store
 from ...numerics.cores import CORES
 from ..notebook import graded
 from .steps import absolute_step
@@ -465,7 +465,7 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
             raise MeshError("every method needs positive steps and iteration counts of at least 1")
 
     # while grading, every student's notebook asks for the same comparison: computed once, then read
-    name = eigenbasis_store.key("denoising_comparison", V_clean, F, out.sigmas, int(seed), out.grids)
+    name = experiment_store.key("denoising_comparison", V_clean, F, out.sigmas, int(seed), out.grids)
     if graded() and _restore(out, experiment_store.load(name)):
         return out
 
