@@ -10,6 +10,7 @@ from diagnoses import assert_diagnosed
 from geomlib import check
 from geomlib.lessons import symbolic
 from geomlib.teaching.check import forms as catalogues
+from geomlib.teaching.check.catalogue import first_mistake
 
 SEEDS = (0, 1, 2, 4182)
 
@@ -273,3 +274,85 @@ def test_every_wrong_kappa_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
 
 def test_the_mixed_terms_without_their_factor_2_are_named():
     assert_diagnosed(check.normal_curvature(single_mixed_terms, seed=5), "lack their factor 2")
+
+
+# ---------------------------------------------------------------- principal curvatures from (I, II)
+def learner_k(I, II, order=1, ignore_I=False, inverse="I", half=True, swap=False, K_sign=1, det_I=True):
+    """A learner's kappa_1, kappa_2 = H +- sqrt(H^2 - K), written apart from the check, with knobs for the mistakes."""
+    I, II = sp.Matrix(I), sp.Matrix(II)
+    if ignore_I:
+        I = sp.eye(2)
+    L = I.inv() * II if inverse == "I" else II.inv() * I
+    H = L.trace() / (2 if half else 1)
+    K = L.det() if det_I else II.det()
+    if swap:
+        H, K = K, H
+    root = sp.sqrt(H**2 - K_sign * K)
+    return (H + root, H - root)[::order]
+
+
+PRINCIPAL_CORRECT = {
+    "closed form": learner_k,
+    "II I^-1, same eigenvalues": lambda I, II: _right_left(I, II),
+    "roots of det(II - k I) = 0": lambda I, II: _quadratic(I, II),
+    "simplified": lambda I, II: tuple(sp.simplify(k) for k in learner_k(I, II)),
+    "a list": lambda I, II: list(learner_k(I, II)),
+}
+
+
+def _right_left(I, II):
+    L = II * I.inv()  # similar to I^-1 II: I (I^-1 II) I^-1
+    H, K = L.trace() / 2, L.det()
+    return H + sp.sqrt(H**2 - K), H - sp.sqrt(H**2 - K)
+
+
+def _quadratic(I, II):
+    k = sp.Symbol("k")
+    A, B, C = sp.Poly((II - k * I).det(), k).all_coeffs()  # det I k^2 + B k + det II
+    return (-B + sp.sqrt(B**2 - 4 * A * C)) / (2 * A), (-B - sp.sqrt(B**2 - 4 * A * C)) / (2 * A)
+
+
+PRINCIPAL_WRONG = {
+    "ascending": (dict(order=-1), "the pair is in the wrong order"),
+    "II alone": (dict(ignore_I=True), "the eigenvalues of II alone"),
+    "II^-1 I": (dict(inverse="II"), "radii 1/kappa"),
+    "trace, not half": (dict(half=False), "H is the trace of L"),
+    "H and K swapped": (dict(swap=True), "H and K are swapped"),
+    "H^2 + K": (dict(K_sign=-1), "the sign of K under the root"),
+    "det II": (dict(det_I=False), "K is det II"),
+}
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("name", PRINCIPAL_CORRECT)
+def test_principal_curvatures_accept_correct_variants(name, seed):
+    result = check.principal_curvatures(PRINCIPAL_CORRECT[name], seed=seed)
+    assert result.passed and "sphere" in result.message and "Monge" in result.message, result.message
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("name", PRINCIPAL_WRONG)
+def test_principal_curvatures_name_the_mistakes_written_by_hand(name, seed):
+    knobs, phrase = PRINCIPAL_WRONG[name]
+    result = check.principal_curvatures(lambda I, II: learner_k(I, II, **knobs), seed=seed)
+    assert_diagnosed(result, phrase)
+    assert result.partial
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("entry", [e for e in catalogues.PRINCIPAL_MISTAKES if e.build], ids=repr)
+def test_every_wrong_pair_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    cases = catalogues.principal_cases(np.random.default_rng(seed))
+    right = [catalogues._eig(c.I_at, c.II_at) for c in cases]
+    mistake = first_mistake(
+        catalogues.PRINCIPAL_MISTAKES, cases, [entry.build(c) for c in cases], lambda c: right[cases.index(c)]
+    )
+    assert mistake is not None and mistake.diagnosis.startswith(entry.diagnosis.split("{")[0]) and mistake.typical
+
+
+def test_principal_curvatures_refuse_a_dict_and_name_a_scaled_answer_without_credit():
+    eigenvals = check.principal_curvatures(lambda I, II: (I.inv() * II).eigenvals())
+    assert_diagnosed(eigenvals, "returned a dict")
+    scaled = check.principal_curvatures(lambda I, II: tuple(1.5 * k for k in learner_k(I, II)))
+    assert_diagnosed(scaled, "differ from the eigenvalues of I^-1 II")
+    assert not eigenvals.partial and not scaled.partial

@@ -42,6 +42,7 @@ SHORTCUTS = {
     "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
     "normal_curvature": lambda forms, a, b, c, u, v, phi: symbolic.forms_normal_curvature(forms, a, b, c, u, v, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
+    "principal_curvatures": lambda I, II: symbolic.forms_principal_curvatures(I, II),
 }
 
 

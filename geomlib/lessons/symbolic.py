@@ -69,6 +69,7 @@ __all__ = [
     "ellipsoid_forms",
     "ellipsoid_normal_curvature",
     "forms_normal_curvature",
+    "forms_principal_curvatures",
     "unit_tangent",
     "sphere",
     "torus",
@@ -798,6 +799,23 @@ def ellipsoid_forms(a, b, c, u, v):
     II = sp.Matrix([[p_uu.dot(minus_n), p_uv.dot(minus_n)], [p_uv.dot(minus_n), p_vv.dot(minus_n)]])
     at = {s: sp.sympify(u), t: sp.sympify(v)}
     return I.subs(at, simultaneous=True), II.subs(at, simultaneous=True)
+
+
+def forms_principal_curvatures(I, II):
+    """(kappa_1, kappa_2), kappa_1 >= kappa_2: the eigenvalues of the shape operator L = I^-1 II, in 1/length.
+
+    ``I``, ``II``: 2x2 sympy matrices (expressions in any symbols, or numbers), II with the normal
+    the curvatures are signed by. L is similar to the symmetric I^-1/2 II I^-1/2 (I is positive
+    definite), so its eigenvalues are real: with H = tr(L) / 2 and K = det L = det II / det I they are
+    H +- sqrt(H^2 - K), and H^2 - K = (kappa_1 - kappa_2)^2 / 4 >= 0. Equal at an umbilic. sympy
+    expressions, simplified.
+    """
+    I, II = sp.Matrix(I), sp.Matrix(II)
+    L = I.adjugate() * II / I.det()  # I^-1 II without a division inside the inverse
+    H = sp.simplify(L.trace() / 2)
+    K = sp.simplify(II.det() / I.det())
+    root = sp.sqrt(sp.simplify(H**2 - K))
+    return H + root, H - root
 
 
 def unit_tangent(E, F, G, phi):

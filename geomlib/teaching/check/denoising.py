@@ -1,7 +1,5 @@
 """Checks of the exercises of notebook 07: the noise, the error, the experiment and the sweep.
 
-Each catalogue of typical mistakes is data (``check.catalogue``), read by the one matcher.
-
 ``add_noise(fn)`` checks ``fn(V, F, sigma, seed) -> V'``: Gaussian noise with standard
 deviation ``s = sigma * d`` per coordinate, ``d`` the bounding-box diagonal of V, independent
 per vertex and coordinate, seeded, V untouched. Noise is random, so this check is statistical:
@@ -233,12 +231,8 @@ def _run(sigma, tau, iterations, directions=False):
     X = np.random.default_rng(_EXP_SEED).standard_normal(V.shape)
     W = V + sigma * d * X / np.linalg.norm(X, axis=1, keepdims=True) if directions else noise(V, F, sigma, _EXP_SEED)
     P = implicit_smoothing(W, F, tau, iterations)
-    return {
-        "right": _rms(P, V) / d,
-        "noisy": _rms(P, W) / d,
-        "noisy d": _rms(P, W) / bounding_box_diagonal(W),
-        "noise": _rms(W, V) / d,
-    }
+    pairs = {"right": (P, V, d), "noisy": (P, W, d), "noisy d": (P, W, bounding_box_diagonal(W)), "noise": (W, V, d)}
+    return {key: _rms(A, B) / diagonal for key, (A, B, diagonal) in pairs.items()}
 
 
 def _experiment_cases():

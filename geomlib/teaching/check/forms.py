@@ -12,10 +12,10 @@ import numpy as np
 from .catalogue import Case, Wrong, answer, judge, number
 from .result import Mistake, call, case_rng, exercise
 
-__all__ = ["fundamental_forms", "normal_curvature"]
+__all__ = ["fundamental_forms", "normal_curvature", "principal_curvatures"]
 
 _PAIR = "return the pair (I, II): I = Matrix([[E, F], [F, G]]), II = Matrix([[e, f], [f, g]])"
-_SURFACES = ("lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid")  # forbidden in both exercises
+_SURFACES = ("lessons.symbolic.ParametricSurface", "lessons.symbolic.ellipsoid")  # forbidden in every exercise
 _OWN = ("lessons.symbolic.forms_normal_curvature", "lessons.symbolic.unit_tangent")
 
 
@@ -70,7 +70,8 @@ def _values(exprs, symbols, points, learner=True):
     f = sp.lambdify(symbols, exprs, modules="numpy")
     with np.errstate(all="ignore"):
         vals = np.array([np.broadcast_to(np.asarray(f(*pt), dtype=complex), 6) for pt in points]).T
-    if learner and not np.all(np.isfinite(vals)) or np.abs(vals.imag).max() > 1e-9 * (1 + np.abs(vals.real).max()):
+    real = np.all(np.isfinite(vals)) and np.abs(vals.imag).max() <= 1e-9 * (1 + np.abs(vals.real).max())
+    if learner and not real:
         raise Mistake(
             "the expressions are not real numbers at points inside the domain",
             "check square roots and divisions: 0 < v < pi, a, b, c > 0",
@@ -99,7 +100,6 @@ def _same_factor(got, right):
 
 
 _UV = [2, 1, 0, 5, 4, 3]  # E, F, G, e, f, g with the roles of u and v exchanged
-
 # fmt: off
 FORMS_MISTAKES = [
     # the learner's p(u, v) is the true p(v, u): its p_u is the true p_v, and p_u x p_v turns round
@@ -153,9 +153,8 @@ def fundamental_forms(fn):
 
 def _kappa(k, du, dv, two=2.0, divide=True):
     """II(t, t) / I(t, t) (or II(t, t) alone) for the forms k = (E, F, G, e, f, g) and t = (du, dv)."""
-    E, F, G, e, f, g = k
-    II_tt, I_tt = e * du**2 + two * f * du * dv + g * dv**2, E * du**2 + two * F * du * dv + G * dv**2
-    return II_tt / I_tt if divide else II_tt
+    form = lambda X, Y, Z: X * du**2 + two * Y * du * dv + Z * dv**2  # t^T [[X, Y], [Y, Z]] t
+    return form(*k[3:]) / form(*k[:3]) if divide else form(*k[3:])
 
 
 def _tangent(k, phi):
@@ -217,4 +216,112 @@ def normal_curvature(fn):
     cases, hint = kappa_cases(case_rng()), "return kappa_n as one number for the given forms, a, b, c, u, v and phi"
     answers = [np.array([number(answer(fn, c, phi=float(phi)), hint=hint) for phi in c.phis]) for c in cases]
     judge(KAPPA_MISTAKES, cases, answers, right=_on(_right))
+    return [c.label for c in cases]
+
+
+_PRINCIPAL = "kappa_1,2 = H +- sqrt(H^2 - K), H = tr(I^-1 II) / 2, K = det II / det I: the eigenvalues of L = I^-1 II"
+
+
+def principal_cases(rng):
+    """(I, II) in sympy, the points (values of their symbols) they are read at, and I, II there: the ellipsoid
+    at (a, 0, 0) (an umbilic where b = c), the sphere (all umbilics), a Monge patch z = h(x, y) at a point
+    with F, f != 0 and K < 0 (exact), the ellipsoid at a point where F != 0 (floats)."""
+    import sympy as sp
+
+    from ...lessons.symbolic import ellipsoid_forms
+
+    a, b, c, r, v = sp.symbols("a b c r v", positive=True)
+    abc = [rng.uniform(0.5, 2.5, 3) for _ in range(3)] + [np.array([1.3, 0.8, 0.8])]  # the last: b = c
+    hx, hy = (int(rng.choice([-2, -1, 1, 2])) for _ in range(2))
+    hxx, hyy, hxy = int(rng.integers(1, 4)), -int(rng.integers(1, 4)), int(rng.integers(1, 3))
+    W = sp.sqrt(1 + hx**2 + hy**2)
+    A, B, C = rng.uniform(0.6, 2.0, 3)
+    u0, v0 = rng.uniform(0.3, 1.2), rng.uniform(0.4, 1.2)
+    sphere = (sp.diag(r**2 * sp.sin(v) ** 2, r**2), sp.diag(r * sp.sin(v) ** 2, r))
+    monge = (sp.Matrix([[1 + hx**2, hx * hy], [hx * hy, 1 + hy**2]]), sp.Matrix([[hxx, hxy], [hxy, hyy]]) / W)
+    at_F = f"the ellipsoid ({A:.2f}, {B:.2f}, {C:.2f}) at (u, v) = ({u0:.2f}, {v0:.2f}), where F != 0"
+    pairs = [
+        ("the ellipsoid at (a, 0, 0)", sp.diag(b**2, c**2), sp.diag(a, a), (a, b, c), abc),
+        ("the sphere of radius r", *sphere, (r, v), [rng.uniform([0.3, 0.2], [3.0, 2.9]) for _ in range(3)]),
+        ("a Monge patch at a point where K < 0 and F, f != 0", *monge, (), [()]),
+        (at_F, *ellipsoid_forms(*(float(x) for x in (A, B, C, u0, v0))), (), [()]),
+    ]
+    cases = []
+    for label, I, II, symbols, points in pairs:
+        at = np.array([np.array(sp.Matrix.vstack(I, II).subs(dict(zip(symbols, p))), dtype=float) for p in points])
+        cases.append(Case(label, I=I, II=II).but(symbols=symbols, points=points, I_at=at[:, :2], II_at=at[:, 2:], n=2))
+    return cases
+
+
+def _eig(I, II):
+    """(P, 2): the eigenvalues of I^-1 II at each point, largest first (real: L is similar to a symmetric matrix)."""
+    return -np.sort(-np.linalg.eigvals(np.linalg.solve(I, II)).real, axis=-1)
+
+
+def _from_HK(H, K):
+    """(P, 2): H +- sqrt(H^2 - K), NaN where the root is not real."""
+    d = H**2 - K
+    root = np.sqrt(np.where(d >= 0, d, np.nan))
+    return np.stack([H + root, H - root], axis=-1)
+
+
+def _HK(c):
+    L = np.linalg.solve(c.I_at, c.II_at)
+    return np.trace(L, axis1=1, axis2=2) / 2, np.linalg.det(c.II_at) / np.linalg.det(c.I_at)
+
+
+def _pair(out, case):
+    """(P, 2) floats: the two expressions returned, at the case's points; NaN where they are not real."""
+    import sympy as sp
+
+    if isinstance(out, dict):
+        raise Mistake(
+            "the function returned a dict, as sympy's eigenvals() does (a repeated eigenvalue appears once)",
+            "return the pair (kappa_1, kappa_2), kappa_1 >= kappa_2",
+            typical=False,
+        )
+    if not isinstance(out, (tuple, list)) or len(out) != 2:
+        raise Mistake(
+            f"the function returned {type(out).__name__}, not the pair (kappa_1, kappa_2)",
+            "end with `return kappa_1, kappa_2`",
+            typical=False,
+        )
+    exprs = [sp.sympify(x) for x in out]
+    extra = set().union(*(x.free_symbols for x in exprs)) - set(case.symbols)
+    if extra:
+        raise Mistake(
+            f"the curvatures hold symbols that I and II do not: {sorted(map(str, extra))}",
+            "build them from the entries of I and II only",
+            typical=False,
+        )
+    exact = [dict(zip(case.symbols, map(sp.Rational, p))) for p in case.points]  # an umbilic's root is exactly 0
+    values = np.array([[complex(x.subs(at).evalf(30)) for x in exprs] for at in exact])
+    return np.where(np.abs(values.imag) > 1e-9 * (1 + np.abs(values.real)), np.nan, values.real)
+
+
+# fmt: off
+PRINCIPAL_MISTAKES = [
+    Wrong("kappa_1 < kappa_2: the pair is in the wrong order", "kappa_1 = H + sqrt(H^2 - K) is the larger", build=lambda c: _eig(c.I_at, c.II_at)[:, ::-1]),
+    Wrong("the curvatures are the eigenvalues of II alone: I is left out", _PRINCIPAL, build=lambda c: _eig(np.eye(2)[None].repeat(len(c.points), 0), c.II_at)),
+    Wrong("the curvatures are the eigenvalues of II^-1 I: radii 1/kappa, not curvatures", _PRINCIPAL, build=lambda c: -np.sort(-1 / _eig(c.I_at, c.II_at), axis=1)),
+    Wrong("H and K are swapped: K +- sqrt(K^2 - H)", _PRINCIPAL, build=lambda c: _from_HK(*_HK(c)[::-1])),
+    Wrong("H is the trace of L, not half of it", _PRINCIPAL, build=lambda c: _from_HK(2 * _HK(c)[0], _HK(c)[1])),
+    Wrong("the root is sqrt(H^2 + K): the sign of K under the root", "(kappa_1 - kappa_2)^2 / 4 = H^2 - K", build=lambda c: _from_HK(_HK(c)[0], -_HK(c)[1])),
+    Wrong("K is det II, not det II / det I", _PRINCIPAL, build=lambda c: _from_HK(_HK(c)[0], np.linalg.det(c.II_at))),
+    Wrong("the principal curvatures differ from the eigenvalues of I^-1 II on {label}", _PRINCIPAL, typical=False),
+]
+# fmt: on
+
+
+@exercise(
+    "principal_curvatures",
+    reread="After the discussion · the shape operator L = I^-1 II and its eigenvalues",
+    forbid=("lessons.symbolic.forms_principal_curvatures", *_SURFACES),
+    tools=("sympy", "numpy", "scipy"),
+)
+def principal_curvatures(fn):
+    """Check ``fn(I, II) -> (kappa_1, kappa_2)`` (sympy), by value at points drawn each run."""
+    cases = principal_cases(case_rng())
+    answers = [_pair(call(fn, c.I.copy(), c.II.copy()), c) for c in cases]
+    judge(PRINCIPAL_MISTAKES, cases, answers, right=lambda c: _eig(c.I_at, c.II_at))
     return [c.label for c in cases]
