@@ -450,7 +450,9 @@ def use(fn, check, reference):
 
 
 def reveal(fn, check):
-    """geomlib's own routine for an exercise, shown once the learner's ``fn`` passes ``check``.
+    """Show geomlib's own routine for an exercise once the learner's ``fn`` passes ``check``; returns None.
+
+    It displays what it shows itself, so it can stand anywhere in a cell (not only last).
 
     Placed after an exercise: the solution version (whose answer passes) shows the
     routine to compare with; a released assignment shows it only once the student's
@@ -463,9 +465,9 @@ def reveal(fn, check):
     result = check.evaluate(fn)
     if result.passed:
         print(f"Your {getattr(fn, '__name__', 'function')} passes its check. geomlib's own, to compare with yours:")
-        for dotted in check.own[1:]:
+        for dotted in check.own:
             display(show_source(resolve(dotted)))
-        return show_source(resolve(check.own[0]))
+        return None
     print(
         f"geomlib's own {_public(check.own[0])} is shown here once your "
         f"{getattr(fn, '__name__', 'function')} passes its check above: write yours first."
