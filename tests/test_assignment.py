@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 import build_assignment  # noqa: E402
 
 from geomlib import check  # noqa: E402
-from geomlib.teaching.check.fence import resolve as _resolve  # noqa: E402
+from geomlib.teaching.check.fence import resolve  # noqa: E402
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 EXERCISE_NOTEBOOKS = [p for p in NOTEBOOKS if p.name[:2] != "00" and p.name[2] == "_"]
@@ -66,7 +66,7 @@ PACKAGE_LINES = _package_lines()
 
 def forbidden_lines(dotted):
     """Lines of a routine's source that only its answer would contain (its body, not its signature or docs)."""
-    target = _resolve(dotted)
+    target = resolve(dotted)
     members = [m for m in vars(target).values() if callable(m)] if isinstance(target, type) else [target]
     lines = set()
     for member in members:

@@ -1,15 +1,21 @@
-"""Ground rules: every exercise refuses an answer that calls geomlib's own routine for it.
+"""Ground rules: an allow-list. An answer may use numpy and scipy (sympy in 02) and the geomlib
+routines its exercise hands it (``check.NAME.allow``); any other geomlib routine or a geometry
+library fails the check with no points, named.
 
-Each exercise's check names the routines its answer may not call (``check.NAME.forbid``).
-An answer that calls one (directly, through a lambda, or through another geomlib routine
-that calls it) fails with no points and is told which routine and why. ``SHORTCUTS``
-holds, for every exercise of ``geomlib.check``, the shortest such answer: a new exercise
-without one fails ``test_every_exercise_has_a_shortcut_here``.
+``SHORTCUTS`` holds, for every exercise of ``geomlib.check``, the shortest answer through
+geomlib's own routine: a new exercise without one fails ``test_every_exercise_has_a_shortcut_here``.
+``BREACHES`` holds answers through a routine the exercise's rules do not name (geomlib's helpers,
+libigl, trimesh): refused all the same. The exercise text (tests/test_reading_path.py), the
+sentence ``check.NAME.rules`` and the grading guide say the same thing.
 """
 
+from pathlib import Path
+
+import igl
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import trimesh
 
 import geomlib
 import geomlib.lessons.smoothing as smoothing
@@ -17,7 +23,8 @@ import geomlib.lessons.spectral as spectral
 import geomlib.lessons.symbolic as symbolic
 import geomlib.numerics.eigen as eigen
 from geomlib import check
-from geomlib.lessons.laplace import intrinsic_cotangent_matrix
+from geomlib.lessons.laplace import intrinsic_cotangent_matrix, voronoi_pieces
+from geomlib.numerics.eigen import largest_eigenpair
 from geomlib.teaching.check.result import reveal
 
 SHORTCUTS = {
@@ -62,8 +69,48 @@ def test_the_geomlib_shortcut_earns_nothing_and_is_named(name):
     assert not result.passed and not result.partial, result.message
     assert "calls geomlib's `" in result.message and "earns no points" in result.message, result.message
     named = result.message.split("`")[1]
-    assert named in {dotted.rpartition(".")[2] for dotted in checker.forbid}
-    assert "Ground rules" in checker.rules and f"`{named}`" in checker.rules
+    assert named not in {dotted.rpartition(".")[2] for dotted in checker.allow}
+    assert checker.rules.startswith("Ground rules: ") and "no other geomlib routine" in checker.rules
+
+
+def _edges_and_valence(V, F):
+    from geomlib.mesh.topology import edges, valence
+
+    E, n = edges(F), len(V)
+    A = sp.coo_matrix((np.ones(2 * len(E)), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])), (n, n))
+    d = valence(F, n).astype(float)
+    return sp.diags(d), (A - sp.diags(d)).tocsr()
+
+
+def _trimesh_measure(V, F):
+    from trimesh.curvature import discrete_gaussian_curvature_measure
+
+    mesh = trimesh.Trimesh(V, F, process=False)
+    return discrete_gaussian_curvature_measure(mesh, V, 0.0) / (mesh.area / len(V))
+
+
+# answers through a routine no ground rule names: geomlib's helpers, libigl (compiled), trimesh
+BREACHES = {
+    "uniform_laplacian": (_edges_and_valence, "geomlib's `edges`"),
+    "gaussian_curvature": (_trimesh_measure, "trimesh's `"),
+    "cotangent_matrix": (lambda l, F: igl.cotmatrix_intrinsic(l, F), "libigl's `cotmatrix_intrinsic`"),
+    "mixed_areas": (lambda V, F: voronoi_pieces(V, F).sum(axis=1)[F].ravel()[: len(V)], "geomlib's `voronoi_pieces`"),
+    "lam_max": (lambda M, C: largest_eigenpair(-C.tocsr())[0], "geomlib's `largest_eigenpair`"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(BREACHES))
+def test_a_routine_outside_the_allow_list_earns_nothing_and_is_named(name):
+    fn, named = BREACHES[name]
+    result = getattr(check, name).evaluate(fn)
+    assert not result.passed and not result.partial, result.message
+    assert f"calls {named}" in result.message and "earns no points" in result.message, result.message
+
+
+def test_the_guide_states_the_allow_list_in_the_checks_words():
+    guide = " ".join((Path(__file__).resolve().parents[1] / "docs" / "grading.md").read_text().split())
+    assert "The ground rules are an allow-list." in guide
+    assert " ".join(check.mixed_areas.rules.split()) in guide
 
 
 def test_a_call_hidden_in_a_helper_is_still_seen():
@@ -74,8 +121,8 @@ def test_a_call_hidden_in_a_helper_is_still_seen():
         helper(V, F)
         return geomlib.laplacian(V, F, weights="uniform")
 
-    result = check.uniform_laplacian.evaluate(answer)
-    assert not result.passed and "`laplacian`" in result.message
+    result = check.uniform_laplacian.evaluate(answer)  # the first routine entered is named
+    assert not result.passed and "`mean_curvature`" in result.message
 
 
 def power_iteration(M, C):

@@ -6,7 +6,7 @@ at least one question before its answer (**Predict.**), and links its appendix
 (``NNa_dig_deeper_*.ipynb``), which links back. A student reads code cells that each do one
 thing: every cell that holds a claim is hidden, no core cell times itself, every figure goes
 through ``show_figure`` with an alt text, and every 3D view is described. Each exercise
-states its ground rules (the routines ``check.NAME.forbid`` names) and each of the notebooks
+states its ground rules (the sentence ``check.NAME.rules``) and each of the notebooks
 01-07 has a discussion graded by hand.
 """
 
@@ -133,8 +133,8 @@ def test_every_exercise_states_its_ground_rules(path):
     for i, name in exercises(nb):
         text = next(c.source for c in reversed(nb.cells[:i]) if c.cell_type == "markdown")
         assert "**Ground rules:**" in text, f"{name}: no ground rules above the exercise"
-        for dotted in getattr(check, name).forbid:
-            assert f"`{dotted.rpartition('.')[2]}`" in text, f"{name}: the ground rules do not name {dotted}"
+        rules = getattr(check, name).rules.removeprefix("Ground rules: ")
+        assert " ".join(rules.split()) in " ".join(text.split()), f"{name}: the ground rules are not check.{name}.rules"
 
 
 @pytest.mark.parametrize("path", [p for p in CORES if p.name[:2] != "00"], ids=lambda p: p.name)

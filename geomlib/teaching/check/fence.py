@@ -45,7 +45,9 @@ GEOMETRY_LIBRARIES = {
     "libigl": "libigl",
 }
 
-_LAZY = ("__getattr__", "__dir__")  # a package's lazy attributes (``geomlib.laplacian``): no routine yet
+# a package's lazy attributes (``geomlib.laplacian``), a module's body run by an import and geomlib's
+# import hook (its short module names) compute nothing of an answer
+_LAZY = ("__getattr__", "__dir__", "<module>", "find_spec", "create_module", "exec_module")
 _GEOMLIB = str(Path(__file__).resolve().parents[2]) + os.sep
 _CHECKS = str(Path(__file__).resolve().parent) + os.sep
 
@@ -93,11 +95,6 @@ def fenced_file(filename):
     return filename.startswith(_GEOMLIB) and not filename.startswith(_CHECKS)
 
 
-def public_name(code):
-    """How a refusal names a fenced routine: geomlib's `laplacian`, trimesh's `...`."""
-    return f"geomlib's `{code.co_qualname}`"
-
-
 class Fence:
     """What an exercise's answer may not enter: geomlib outside ``allow``, and geometry libraries."""
 
@@ -112,35 +109,47 @@ class Fence:
         return self._allowed
 
     def profile(self, on_hit):
-        """A profile function calling ``on_hit(name)`` at an entry into fenced code (module docstring)."""
-        allowed, libraries = self.allowed(), tuple(self.libraries.items())
+        """A profile function calling ``on_hit(name)`` at an entry into fenced code (module docstring).
 
-        def library(filename):
-            for folder, name in libraries:
-                if filename.startswith(folder):
-                    return name
-            return None
+        Everything it uses is bound as a default argument, none looked up by name when it
+        runs: code in the sandbox cannot swap a module global or a builtin under it.
+        """
 
-        def inside_allowed(frame):
-            while frame is not None:
-                if frame.f_code in allowed:
-                    return True
-                frame = frame.f_back
-            return False
-
-        def profile(frame, event, arg):
+        def profile(
+            frame,
+            event,
+            arg,
+            allowed=self.allowed(),
+            libraries=tuple(self.libraries.items()),
+            on_hit=on_hit,
+            geomlib=_GEOMLIB,
+            checks=_CHECKS,
+            lazy=_LAZY,
+        ):
             if event != "call":
                 return
             code, caller = frame.f_code, frame.f_back
-            where = caller.f_code.co_filename if caller is not None else ""
-            if fenced_file(code.co_filename):
-                if code.co_qualname in _LAZY or fenced_file(where) or code in allowed or inside_allowed(caller):
+            name = code.co_filename
+            where = "" if caller is None else caller.f_code.co_filename
+            inside = where.startswith(geomlib) and not where.startswith(checks)
+            if name.startswith(geomlib) and not name.startswith(checks):
+                if inside or code.co_name in lazy or code in allowed:
                     return
-                on_hit(public_name(code))
-            else:
-                name = library(code.co_filename)
-                if name is not None and library(where) is None and not fenced_file(where):
-                    on_hit(f"{name}'s `{code.co_qualname}`")
+                up = caller
+                while up is not None:  # a callback of an allowed routine (through numpy, scipy)
+                    if up.f_code in allowed:
+                        return
+                    up = up.f_back
+                on_hit(f"geomlib's `{code.co_qualname}`")
+                return
+            for folder, library in libraries:
+                if name.startswith(folder):
+                    for other, _ in libraries:
+                        if where.startswith(other):
+                            return
+                    if not inside:
+                        on_hit(f"{library}'s `{code.co_qualname}`")
+                    return
 
         return profile
 

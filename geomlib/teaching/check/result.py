@@ -102,7 +102,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..notebook import graded, strict_claims
-from .fence import Fence, cold_caches, resolve, untrip
+from .fence import GEOMETRY_LIBRARIES, Fence, cold_caches, resolve, untrip
 
 __all__ = [
     "CheckResult",
@@ -204,19 +204,14 @@ class _Rules:
         self.fence = Fence(self.allow)
 
     def sentence(self):
-        tools = ", ".join(self.tools[:-1]) + f" and {self.tools[-1]}"
+        tools = list(self.tools)
         if self.allow:
-            tools = ", ".join(self.tools) + " and geomlib's " + ", ".join(f"`{_public(d)}`" for d in self.allow)
-        named = ", ".join(f"`{_public(d)}`" for d in self.forbid)
-        such = f" (such as {named})" if named else ""
-        return (
-            f"Ground rules: write it with {tools}. Any other geomlib routine{such}, a geometry library "
-            "(libigl, trimesh, gpytoolbox, ...) or a copy of geomlib's code earns no points."
-        )
+            tools[-1:] = [tools[-1], "geomlib's " + _listed([f"`{_public(d)}`" for d in self.allow])]
+        return f"Ground rules: {_listed(tools)} only: no other geomlib routine, geometry library or copied code."
 
     def refusal(self, name, why=""):
         if why:
-            diagnosis = f"the function {why}, which grading refuses, so it earns no points"
+            diagnosis = f"the function {why}; grading refuses it, so it earns no points"
         elif name.startswith("geomlib's") and name.split("`")[1] in {_public(d) for d in self.own}:
             diagnosis = f"the function calls {name}, which this exercise asks you to write, so it earns no points"
         elif name.startswith("geomlib's"):
@@ -230,16 +225,27 @@ def _public(dotted):
     return dotted.rpartition(".")[2]
 
 
+def _listed(words):
+    """'a', 'a and b', 'a, b and c'."""
+    return ", ".join(words[:-1]) + (" and " if len(words) > 1 else "") + words[-1]
+
+
 _RULES = [None]  # the rules of the exercise being checked (checks run one at a time)
 _WATCHED = [None]  # while the learner's function runs in this process: the list its refusals go to
 
 
 def _audit(event, args):
-    """Refuse switching the watcher off while the learner's function runs (sys.addaudithook: for good)."""
+    """While the learner's function runs, refuse switching the watcher off and importing a geometry
+    library (sys.addaudithook: installed for good, idle between checks)."""
     hits = _WATCHED[0]
-    if hits is not None and event in ("sys.setprofile", "sys.settrace"):
-        hits.append(Refused(event, f"calls {event}, which would switch off the check's watcher"))
+    if hits is None:
+        return
+    if event in ("sys.setprofile", "sys.settrace") and sys._getframe(1).f_code.co_filename != threading.__file__:
+        hits.append(Refused(event, f"calls {event}, which would switch the check's watcher off"))
         raise RuntimeError(f"{event} is refused while an exercise is checked")
+    if event == "import" and args[0].partition(".")[0] in GEOMETRY_LIBRARIES:
+        hits.append(Refused(args[0], f"imports {args[0]}, a geometry library"))
+        raise ImportError(f"{args[0]} is refused while an exercise is checked")
 
 
 sys.addaudithook(_audit)
@@ -265,6 +271,8 @@ def _watching(fence, hits, namespaces=()):
         yield
     finally:
         _WATCHED[0] = None
+        if threading.getprofile() is not profile and not hits:
+            hits.append(Refused("threading.setprofile", "calls threading.setprofile, which would unwatch its threads"))
         threading.setprofile(None)
         sys.setprofile(previous)
         untrip(swapped)
@@ -414,16 +422,7 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
 
         def partial_credit(fn, seed=None):
             """Partial credit: ``fn`` is right, or the first thing wrong is a typical mistake the check names."""
-            result = evaluate(fn, seed)
-            if result.passed:
-                message = "earned: the function passes its check."
-            elif result.partial:
-                message = "earned: what is wrong is a typical mistake, named by the check above."
-            elif not result.written:
-                message = result.message
-            else:
-                message = f"not earned: the check cannot name what is wrong. {result.message}"
-            return _enforce(CheckResult(f"{name}, partial credit", result.partial, message, written=result.written))
+            return _enforce(credit(evaluate(fn, seed)))
 
         check.exercise, check.reread = name, reread
         check.forbid, check.own, check.allow, check.rules = rules.forbid, rules.own, rules.allow, rules.sentence()
@@ -431,6 +430,19 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
         return check
 
     return wrap
+
+
+def credit(result):
+    """The partial-credit verdict on a check's ``result``: right, or a typical mistake the check names."""
+    if result.passed:
+        message = "earned: the function passes its check."
+    elif result.partial:
+        message = "earned: what is wrong is a typical mistake, named by the check above."
+    elif not result.written:
+        message = result.message
+    else:
+        message = f"not earned: the check cannot name what is wrong. {result.message}"
+    return CheckResult(f"{result.name}, partial credit", result.partial, message, written=result.written)
 
 
 def use(fn, check, reference):
