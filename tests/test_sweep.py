@@ -64,6 +64,36 @@ def test_the_worker_gives_the_serial_numbers_and_the_steps_are_fractions_of_the_
     assert R.values["rms"][0][1, 1, 1] == pytest.approx(geomlib.vertex_rms(P, V), rel=1e-12)
 
 
+def test_while_grading_a_comparison_is_computed_once_and_read_back_bit_for_bit(tmp_path, monkeypatch):
+    V, F = icosphere(2)
+    grids = {("explicit", "uniform"): ((0.3, 0.6), (1, 3)), ("taubin", "uniform"): ((0.5,), (2,))}
+    S = denoising_comparison(V, F, (0.01, 0.03), 2, grids=grids, workers=1)  # not grading: nothing stored
+    monkeypatch.setenv("GEOMLIB_CACHE_DIR", str(tmp_path))
+    assert not (tmp_path / "experiments").exists()
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    first = denoising_comparison(V, F, (0.01, 0.03), 2, grids=grids, workers=1)
+    assert len(list((tmp_path / "experiments").glob("*.npz"))) == 1
+    read = denoising_comparison(V, F, (0.01, 0.03), 2, grids=grids, workers=1)
+    assert np.isnan(read.seconds)  # read back, not computed
+    for R in (first, read):
+        np.testing.assert_array_equal(R.limits, S.limits)
+        for key in S.values:
+            np.testing.assert_array_equal(R.noisy[key], S.noisy[key])
+            for a, b in zip(R.values[key], S.values[key]):
+                np.testing.assert_array_equal(a, b)
+    other = denoising_comparison(V, F, (0.01, 0.03), 3, grids=grids, workers=1)  # another seed: another key
+    assert len(list((tmp_path / "experiments").glob("*.npz"))) == 2
+    assert not np.array_equal(other.values["rms"][0], S.values["rms"][0], equal_nan=True)
+    next((tmp_path / "experiments").glob("*.npz")).write_bytes(b"damaged")  # a damaged file is computed again
+    assert all(
+        np.array_equal(a.limits, b.limits)
+        for a, b in [
+            (denoising_comparison(V, F, (0.01, 0.03), 2, grids=grids, workers=1), S),
+            (denoising_comparison(V, F, (0.01, 0.03), 3, grids=grids, workers=1), other),
+        ]
+    )
+
+
 def test_taubin_pairs_are_trimesh_s_filter_taubin_and_an_unstable_step_is_left_unmeasured():
     V, F = icosphere(2)
     W = geomlib.add_noise(V, F, 0.01, 5)

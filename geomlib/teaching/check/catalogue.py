@@ -83,6 +83,7 @@ __all__ = [
     "run",
     "answer",
     "mesh_cases",
+    "named",
     "matrix_pair",
     "vector",
     "positions",
@@ -224,6 +225,11 @@ def mesh_cases(meshes, rng, facts=None):
     anew with ``rng`` (``meshes.placed``: moved, scaled, jittered, renumbered)."""
     cases = [Case(label, **dict(zip("VF", placed(V, F, rng)))) for label, (V, F) in meshes]
     return cases if facts is None else [c.but(**facts(c.V, c.F)) for c in cases]
+
+
+def named(module, names):
+    """``("module.a", "module.b", ...)`` for ``names = "a b ..."``: an exercise's forbidden or own routines."""
+    return tuple(f"{module}.{name}" for name in names.split())
 
 
 def _copy(x):

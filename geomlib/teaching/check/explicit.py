@@ -1,16 +1,11 @@
-"""Checks of the exercises of notebook 05: lambda_max by power iteration, and the smoothing loop.
+"""Checks of notebook 05: lambda_max by power iteration, and the smoothing loop with the boundary held.
 
-Convention of the workbook: Delta = M^-1 C (C symmetric negative semidefinite,
-M diagonal), lam >= 0 the eigenvalues of -C e = lam M e, one explicit step
-P' = P + tau M^-1 C P, stable for tau < 2 / lam_max. With the boundary B held the
-loop iterates the interior block, P_I <- P_I + tau M_II^-1 (C_II P_I + C_IB P_B), whose
-limit is 2 / lam_max of (M_II, C_II).
-
-Both checks draw their cases anew each run (``case_rng``): an irregular tetrahedron, the
-42-vertex ellipsoid scaled by 3, and an open 6 x 6 grid jittered in the plane and in height
-(20 boundary vertices; the jitter gives the cotangent operator a shape of its own, so a
-rebuilt operator, the uniform one and a moving boundary all end up elsewhere), each placed
-by a random similarity away from the origin.
+Delta = M^-1 C (C symmetric negative semidefinite), lam >= 0 the eigenvalues of -C e = lam M e; one explicit step
+P' = P + tau M^-1 C P is stable for tau < 2 / lam_max. With the boundary B held the loop iterates the interior
+block, P_I <- P_I + tau M_II^-1 (C_II P_I + C_IB P_B), whose limit is 2 / lam_max of (M_II, C_II). Cases, placed
+anew each run by a random similarity (``case_rng``): an irregular tetrahedron, the 42-vertex ellipsoid scaled by 3
+and an open 6 x 6 grid jittered in the plane and in height (20 boundary vertices; the jitter gives the cotangent
+operator a shape of its own, so a rebuilt operator, the uniform one and a moving boundary all end up elsewhere).
 """
 
 import numpy as np
@@ -19,15 +14,12 @@ import scipy.sparse as sp
 from ...lessons.laplace import laplacian
 from ...mesh.topology import boundary_vertices
 from ..shapes import surfaces
-from .catalogue import Case, Wrong, agree, judge, number, positions
+from .catalogue import Case, Wrong, agree, judge, named, number, positions
 from .meshes import irregular_tetrahedron, placed
 from .result import Mistake, call, case_rng, exercise
 from .solvers import DENSE, GENERALISED, refusing
 
 __all__ = ["lam_max", "smoothing_loop"]
-
-_REREAD_LIMIT = "section 2 · Why the step has a limit"
-_REREAD_LOOP = "section 3 · The smoothing loop, boundary held"
 
 
 def loop_grid():
@@ -59,8 +51,7 @@ def eigenvalues(m, C):
     return np.linalg.eigvalsh(-(d[:, None] * C.toarray() * d[None, :]))
 
 
-# --------------------------------------------------------------------------
-# lambda_max by power iteration
+# ---------------------------------------------------------------- lambda_max by power iteration
 
 
 def _lam_of(c, scale):
@@ -71,36 +62,27 @@ def _lam_of(c, scale):
 
 # fmt: off
 LAM_MAX_MISTAKES = [
-    Wrong("the function returns the step limit 2 / lam_max, not lam_max", "return lam_max itself",
-          build=lambda c: 2 / c.lam[-1]),
-    Wrong("the smallest eigenvalue was found, not the largest", "power iteration finds the largest",
-          build=lambda c: c.lam[0]),
-    Wrong("the sign of C is flipped: the value is -lam_max, the largest in size of M^-1/2 C M^-1/2",
-          "Q = -M^-1/2 C M^-1/2: C is negative semidefinite", build=lambda c: -c.lam[-1]),
-    Wrong("M is left out: this is the largest eigenvalue of -C itself", "Q = -M^-1/2 C M^-1/2",
-          build=lambda c: _lam_of(c, 0.0)),
-    Wrong("M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2", "Q = -M^-1/2 C M^-1/2", build=lambda c: _lam_of(c, -1.0)),
-    Wrong("M multiplies instead of dividing (-M^1/2 C M^1/2)", "Q = -M^-1/2 C M^-1/2", build=lambda c: _lam_of(c, 0.5)),
-    Wrong("this is Gershgorin's bound max_i (|C_ii| + sum_j |C_ij|) / M_ii, not the eigenvalue it bounds",
-          "iterate until the Rayleigh quotient settles", build=lambda c: np.max(abs(c.C).sum(axis=1).A1 / c.m)),
-    Wrong("the iteration stopped too early: the Rayleigh quotient is still below lam_max on {label}",
-          "iterate until it changes by less than 1e-12 of itself", when=lambda a, r, c: 0.5 * r < a < r * (1 - _LAM_RTOL)),
-    Wrong("lam_max differs from the largest eigenvalue of -C e = lam M e on {label}", typical=False),
+    Wrong('the function returns the step limit 2 / lam_max, not lam_max', 'return lam_max itself', build=lambda c: 2 / c.lam[-1]),
+    Wrong('the smallest eigenvalue was found, not the largest', 'power iteration finds the largest', build=lambda c: c.lam[0]),
+    Wrong('the sign of C is flipped: the value is -lam_max, the largest in size of M^-1/2 C M^-1/2', 'Q = -M^-1/2 C M^-1/2: C is negative semidefinite', build=lambda c: -c.lam[-1]),
+    Wrong('M is left out: this is the largest eigenvalue of -C itself', 'Q = -M^-1/2 C M^-1/2', build=lambda c: _lam_of(c, 0.0)),
+    Wrong('M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2', 'Q = -M^-1/2 C M^-1/2', build=lambda c: _lam_of(c, -1.0)),
+    Wrong('M multiplies instead of dividing (-M^1/2 C M^1/2)', 'Q = -M^-1/2 C M^-1/2', build=lambda c: _lam_of(c, 0.5)),
+    Wrong("this is Gershgorin's bound max_i (|C_ii| + sum_j |C_ij|) / M_ii, not the eigenvalue it bounds", 'iterate until the Rayleigh quotient settles', build=lambda c: np.max(abs(c.C).sum(axis=1).A1 / c.m)),
+    Wrong('the iteration stopped too early: the Rayleigh quotient is still below lam_max on {label}', 'iterate until it changes by less than 1e-12 of itself', when=lambda a, r, c: 0.5 * r < a < r * (1 - _LAM_RTOL)),
+    Wrong('lam_max differs from the largest eigenvalue of -C e = lam M e on {label}', typical=False),
 ]
 # fmt: on
 
+_LIMIT = "explicit_step_limit highest_frequency_mode"
+_OWN = "explicit_smoothing explicit_step ExplicitSmoother"
 _LAM_RTOL = 1e-5  # power iteration stopped at 1e-12 of change lands far closer; the mistakes lie far away
 
 
 @exercise(
     "lam_max",
-    reread=_REREAD_LIMIT,
-    forbid=(
-        "lessons.smoothing.explicit_step_limit",
-        "lessons.smoothing.highest_frequency_mode",
-        "numerics.eigen.largest_eigenvalue",
-        "numerics.eigen.largest_eigenpair",
-    ),
+    reread="section 2 · Why the step has a limit",
+    forbid=named("lessons.smoothing", _LIMIT) + named("numerics.eigen", "largest_eigenvalue largest_eigenpair"),
     own=("numerics.eigen.largest_eigenvalue",),
 )
 def lam_max(fn):
@@ -113,25 +95,18 @@ def lam_max(fn):
         M, C = laplacian(*placed(V, F, rng))
         cases.append(Case(label, M=M, C=C.tocsr()).but(m=M.diagonal()))
     m_I, C_I, I, _ = interior_blocks(*placed(*loop_grid(), rng))
-    cases.append(
-        Case("the interior block of an open grid (rows not summing to 0)", M=sp.diags(m_I), C=C_I[:, I]).but(m=m_I)
-    )
+    block = "the interior block of an open grid (rows not summing to 0)"
+    cases.append(Case(block, M=sp.diags(m_I), C=C_I[:, I]).but(m=m_I))
     cases = [c.but(lam=eigenvalues(c.m, c.C), n=len(c.m)) for c in cases]
     why = "find lam_max by products with Q: power iteration, or a Lanczos solver (scipy's eigsh) on Q"
     with refusing({**GENERALISED, **DENSE}, fn, why):
         answers = [number(call(fn, c.M.copy(), c.C.copy()), hint="return lam_max, one float") for c in cases]
-    judge(
-        LAM_MAX_MISTAKES,
-        cases,
-        answers,
-        right=lambda c: c.lam[-1],
-        same=lambda a, b, c: abs(a - b) <= _LAM_RTOL * max(abs(b), 1e-3 * c.lam[-1]),
-    )
+    same = lambda a, b, c: abs(a - b) <= _LAM_RTOL * max(abs(b), 1e-3 * c.lam[-1])  # noqa: E731
+    judge(LAM_MAX_MISTAKES, cases, answers, right=lambda c: c.lam[-1], same=same)
     return [c.label for c in cases]
 
 
-# --------------------------------------------------------------------------
-# the smoothing loop, boundary held, the step checked against the limit
+# ---------------------------------------------------------------- the smoothing loop, boundary held, tau < the limit
 
 
 def explicit_loop(c, tau=None, N=None, held=True, rebuild=False, areas=-1.0, weights="cotan", coupled=True):
@@ -154,20 +129,15 @@ def loop_mistakes(run, own):
     building each, with the loop's ``own`` entries among them and the catch-alls last."""
     # fmt: off
     return [
-        Wrong("no step was taken: the input positions come back", "return the positions the loop computed",
-              build=lambda c: c.V),
-        Wrong("the loop takes one step too few", "range(N) runs exactly N steps", build=lambda c: run(c, N=c.N - 1)),
-        Wrong("the loop takes one step too many", "range(N) runs exactly N steps", build=lambda c: run(c, N=c.N + 1)),
-        Wrong("the boundary moves: every vertex is updated", "update only the interior rows I",
-              build=lambda c: run(c, held=False)),
-        Wrong("M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V",
-              "call laplacian(V, F) once, before the loop", build=lambda c: run(c, rebuild=True)),
-        Wrong("the loop takes half a step, tau / 2", "the step is tau itself", build=lambda c: run(c, tau=c.tau / 2)),
-        Wrong("the loop smooths with the uniform operator; the task asks for the cotangent one",
-              "laplacian(V, F) with its default weights", build=lambda c: run(c, weights="uniform")),
+        Wrong('no step was taken: the input positions come back', 'return the positions the loop computed', build=lambda c: c.V),
+        Wrong('the loop takes one step too few', 'range(N) runs exactly N steps', build=lambda c: run(c, N=c.N - 1)),
+        Wrong('the loop takes one step too many', 'range(N) runs exactly N steps', build=lambda c: run(c, N=c.N + 1)),
+        Wrong('the boundary moves: every vertex is updated', 'update only the interior rows I', build=lambda c: run(c, held=False)),
+        Wrong('M and C are rebuilt from the moving mesh at every step (curvature flow), not built once from V', 'call laplacian(V, F) once, before the loop', build=lambda c: run(c, rebuild=True)),
+        Wrong('the loop takes half a step, tau / 2', 'the step is tau itself', build=lambda c: run(c, tau=c.tau / 2)),
+        Wrong('the loop smooths with the uniform operator; the task asks for the cotangent one', 'laplacian(V, F) with its default weights', build=lambda c: run(c, weights='uniform')),
         *own,
-        Wrong("the boundary vertices moved on {label}", "hold them: update only the interior rows",
-              when=lambda a, right, c: not agree(a[c.B], c.V[c.B])),
+        Wrong('the boundary vertices moved on {label}', 'hold them: update only the interior rows', when=lambda a, right, c: not agree(a[c.B], c.V[c.B])),
         Wrong("the positions after N steps differ from the loop's on {label}", typical=False),
     ]
     # fmt: on
@@ -175,39 +145,21 @@ def loop_mistakes(run, own):
 
 # fmt: off
 LOOP_MISTAKES = loop_mistakes(explicit_loop, [
-    Wrong("the sign of the step is flipped: the loop runs the heat flow backwards", "P_I += tau M_II^-1 (C P)_I",
-          build=lambda c: explicit_loop(c, tau=-c.tau)),
-    Wrong("C P is not divided by the vertex areas: M is forgotten", "divide row i of C P by M_ii",
-          build=lambda c: explicit_loop(c, areas=0.0)),
-    Wrong("C P is multiplied by the vertex areas instead of divided", "divide row i of C P by M_ii",
-          build=lambda c: explicit_loop(c, areas=1.0)),
-    Wrong("the held boundary's pull C_IB P_B is left out: only C_II P_I moves the interior",
-          "(C P)_I = C_II P_I + C_IB P_B: the interior rows of C with every column",
-          build=lambda c: explicit_loop(c, coupled=False)),
+    Wrong('the sign of the step is flipped: the loop runs the heat flow backwards', 'P_I += tau M_II^-1 (C P)_I', build=lambda c: explicit_loop(c, tau=-c.tau)),
+    Wrong('C P is not divided by the vertex areas: M is forgotten', 'divide row i of C P by M_ii', build=lambda c: explicit_loop(c, areas=0.0)),
+    Wrong('C P is multiplied by the vertex areas instead of divided', 'divide row i of C P by M_ii', build=lambda c: explicit_loop(c, areas=1.0)),
+    Wrong("the held boundary's pull C_IB P_B is left out: only C_II P_I moves the interior", '(C P)_I = C_II P_I + C_IB P_B: the interior rows of C with every column', build=lambda c: explicit_loop(c, coupled=False)),
 ])
 # fmt: on
 
 
 @exercise(
     "smoothing_loop",
-    reread=_REREAD_LOOP,
-    forbid=(
-        "lessons.smoothing.explicit_smoothing",
-        "lessons.smoothing.ExplicitSmoother",
-        "lessons.smoothing.explicit_step",
-        "lessons.smoothing.explicit_step_limit",
-        "lessons.smoothing.highest_frequency_mode",
-        "lessons.smoothing.implicit_smoothing",
-        "lessons.smoothing.ImplicitSmoother",
-        "lessons.operator.LaplaceOperator",
-        "lessons.operator.laplace_operator",
-        "numerics.eigen.largest_eigenvalue",
-    ),
-    own=(
-        "lessons.smoothing.explicit_smoothing",
-        "lessons.smoothing.explicit_step",
-        "lessons.smoothing.ExplicitSmoother",
-    ),
+    reread="section 3 · The smoothing loop, boundary held",
+    forbid=named("lessons.smoothing", f"{_OWN} {_LIMIT} implicit_smoothing ImplicitSmoother")
+    + named("lessons.operator", "LaplaceOperator laplace_operator")
+    + ("numerics.eigen.largest_eigenvalue",),
+    own=named("lessons.smoothing", _OWN),
     allow=("lessons.laplace.laplacian", "mesh.topology.boundary_vertices"),
 )
 def smoothing_loop(fn):
@@ -232,10 +184,8 @@ def smoothing_loop(fn):
         if not m.diagnosis.startswith(_RAISED):  # any exception refuses the step; other mistakes stand
             raise
     else:
-        raise Mistake(
-            f"a step of 1.05 times the limit 2 / lam_max = {past.limit:.4g} ran instead of being refused",
-            "before the first step: if tau >= 2 / lam_max (of M_II, C_II), raise ValueError naming both",
-        )
+        ran = f"a step of 1.05 times the limit 2 / lam_max = {past.limit:.4g} ran instead of being refused"
+        raise Mistake(ran, "before the first step: if tau >= 2 / lam_max (of M_II, C_II), raise ValueError naming both")
     near = 0.95  # past the whole pair's limit on the grid: 2 / lam_max of (M, C) is 0.89 of the block's
     try:
         call(fn, past.V.copy(), past.F.copy(), near * past.limit, 1)

@@ -1,27 +1,13 @@
-"""Checks of the exercises of notebook 04: the eigenpairs by the reduction to Q, and the reconstruction.
+"""Checks of notebook 04: the eigenpairs by the reduction to Q, and the reconstruction V_k = E_k E_k^T M V.
 
-The cases, placed anew each run by a random similarity (``case_rng``), each small enough
-for a dense solve and for ``scipy.sparse.linalg.eigsh`` (which cannot compute all n pairs,
-so every k is below n):
-
-* a jittered ellipsoid with 42 vertices, closed (vertex areas differing by a factor of
-  about 2.25, so that M matters);
-* an open jittered saddle with 49 vertices (a boundary: the natural, Neumann, condition
-  of the cotangent operator, whose null mode is still the constant);
-* the 42-vertex icosphere, whose eigenvalues repeat: any M-orthonormal basis of a
-  repeated eigenvalue's eigenspace is right. Asked for k = 4 (the constant and the
-  threefold lam_1), not 9: at k = 9 ``eigsh`` (its Lanczos iteration starts from one
-  random vector) missed one of the five copies of lam_4 in 44 of 200 runs; at k = 4 it
-  found all three in 200 of 200.
-
-``eigenpairs(fn)`` checks ``fn(M, C, k) -> (lam, E)`` by what defines the answer, not by
-one basis: ``lam`` the k smallest eigenvalues ascending, ``C E = -M E diag(lam)`` and
-``E^T M E = I`` (each eigenvector's sign and the basis of a repeated eigenspace are free).
-Its ground rule, the reduction done by the learner: a generalised solver handed the pair
-(``scipy.linalg.eigh(A, B)``, ``eigsh(A, k, M)``) is refused (:mod:`.solvers`).
-``spectral_reconstruction(fn)`` checks ``fn(V, F, k) -> V_k``; the projection onto the
-first k eigenvectors does not depend on their signs, so the typical mistakes are rebuilt
-from one dense basis and named when met.
+Cases, placed anew each run (``case_rng``), small enough for a dense solve and for ``eigsh`` (every k < n): a
+jittered 42-vertex ellipsoid (closed; areas differing by about 2.25, so M matters), an open jittered 49-vertex
+saddle (the natural boundary condition: the null mode is still the constant) and the 42-vertex icosphere, whose
+eigenvalues repeat. There k = 4 (the constant and the threefold lam_1): at k = 9 ``eigsh`` missed one of the five
+copies of lam_4 in 44 of 200 runs, at k = 4 none in 200. ``eigenpairs`` is judged by what defines the answer (lam
+ascending, C E = -M E diag(lam), E^T M E = I; signs and bases of repeated eigenspaces free) and refuses a
+generalised solver (:mod:`.solvers`); a reconstruction does not depend on the signs, so its mistakes are rebuilt
+from one dense basis.
 """
 
 import numpy as np
@@ -30,7 +16,7 @@ import scipy.linalg
 from ...lessons.laplace import laplacian
 from ...mesh.topology import boundary_vertices
 from ..shapes.surfaces import ellipsoid, saddle, sphere
-from .catalogue import Case, Wrong, agree, judge, positions
+from .catalogue import Case, Wrong, agree, judge, named, positions
 from .catalogue import eigenpairs as pair
 from .meshes import placed
 from .result import Mistake, call, case_rng, exercise
@@ -38,19 +24,14 @@ from .solvers import GENERALISED, refusing
 
 __all__ = ["eigenpairs", "spectral_reconstruction"]
 
-_REREAD_EIGEN = "section 2 · The discrete eigenproblem"
-_REREAD = "section 4 · Reconstruction from the first k eigenvectors"
-
 
 def _meshes(rng):
-    e = ellipsoid(1.0, 0.7, 0.5, subdivisions=1, jitter=0.3, seed=1)
-    s = saddle(n=6, amplitude=0.6, monkey=0.3, jitter=0.25, seed=2)
-    r = sphere(1.0, subdivisions=1)
-    return {
-        "egg": ("a 42-vertex jittered ellipsoid (closed)", *placed(e.V, e.F, rng, jitter=0.0)),
-        "open": ("a 49-vertex jittered saddle (open: a boundary)", *placed(s.V, s.F, rng, jitter=0.0)),
-        "round": ("the 42-vertex icosphere (lam_1 = lam_2 = lam_3)", *placed(r.V, r.F, rng, jitter=0.0)),
-    }
+    shapes = (
+        ("a 42-vertex jittered ellipsoid (closed)", ellipsoid(1.0, 0.7, 0.5, subdivisions=1, jitter=0.3, seed=1)),
+        ("a 49-vertex jittered saddle (open: a boundary)", saddle(n=6, amplitude=0.6, monkey=0.3, jitter=0.25, seed=2)),
+        ("the 42-vertex icosphere (lam_1 = lam_2 = lam_3)", sphere(1.0, subdivisions=1)),
+    )
+    return [(label, *placed(S.V, S.F, rng, jitter=0.0)) for label, S in shapes]
 
 
 def _eig(C, d):
@@ -58,8 +39,7 @@ def _eig(C, d):
     return np.linalg.eigh(-(d[:, None] * C.toarray() * d[None, :]))
 
 
-# --------------------------------------------------------------------------
-# the eigenpairs of C e = -lam M e, by the reduction
+# ---------------------------------------------------------------- the eigenpairs of C e = -lam M e, by the reduction
 
 
 def _residual(E, lam, c):
@@ -71,80 +51,56 @@ def _gram(E, c):
 
 
 def _diagonal(E, c):
-    G = _gram(E, c)
-    return np.allclose(G, np.diag(np.diag(G)), atol=1e-6 * np.abs(G).max())
+    return np.allclose(G := _gram(E, c), np.diag(np.diag(G)), atol=1e-6 * np.abs(G).max())
 
 
 def _some_of(lam, c):
     return np.all(np.abs(lam[:, None] - c.every[None, :]).min(axis=1) <= 1e-6 * c.every[-1])
 
 
+_Q = "Q = -M^-1/2 C M^-1/2"
+
+
 # fmt: off
 LAM_MISTAKES = [
-    Wrong("the sign of C is flipped: the eigenvalues are <= 0, those of M^-1/2 C M^-1/2", "Q = -M^-1/2 C M^-1/2",
-          when=lambda lam, right, c: agree(np.sort(lam), np.sort(-right))),
-    Wrong("the sign of C is flipped, and the first k of M^-1/2 C M^-1/2 are its most negative",
-          "Q = -M^-1/2 C M^-1/2, whose smallest eigenvalues are the ones near 0", build=lambda c: -c.every[::-1][: c.k]),
-    Wrong("the eigenvalues are the k largest, not the k smallest", "the first k ascending, or eigsh with sigma below 0",
-          build=lambda c: c.every[-c.k :]),
-    Wrong("the null mode is lost: lam_0 = 0 (the constant eigenvector) is missing, the values start at lam_1",
-          "keep the eigenpair of lam = 0: the reconstruction needs it", build=lambda c: c.every[1 : c.k + 1]),
-    Wrong("M is left out: these are the eigenvalues of -C itself", "Q = -M^-1/2 C M^-1/2", build=lambda c: c.plain[: c.k]),
-    Wrong("M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2", "Q = -M^-1/2 C M^-1/2: the square roots of the areas",
-          build=lambda c: c.inverse[: c.k]),
-    Wrong("the eigenvalues are not sorted (np.linalg.eig and eigsh return them in no particular order), so the first "
-          "k taken are not the k smallest", "sort them, and the columns with them: order = np.argsort(lam)",
-          when=lambda lam, right, c: _some_of(lam, c) and not agree(lam, right)),
-    Wrong("the eigenvalues differ from the k smallest of C e = -lam M e on {label}", "Q = -M^-1/2 C M^-1/2 and a "
-          "symmetric solver", when=lambda lam, right, c: True, typical=False),
+    Wrong('the sign of C is flipped: the eigenvalues are <= 0, those of M^-1/2 C M^-1/2', _Q, when=lambda lam, right, c: agree(np.sort(lam), np.sort(-right))),
+    Wrong('the sign of C is flipped, and the first k of M^-1/2 C M^-1/2 are its most negative', f'{_Q}, whose smallest eigenvalues are the ones near 0', build=lambda c: -c.every[::-1][:c.k]),
+    Wrong('the eigenvalues are the k largest, not the k smallest', 'the first k ascending, or eigsh with sigma below 0', build=lambda c: c.every[-c.k:]),
+    Wrong('the null mode is lost: lam_0 = 0 (the constant eigenvector) is missing, the values start at lam_1', 'keep the eigenpair of lam = 0: the reconstruction needs it', build=lambda c: c.every[1:c.k + 1]),
+    Wrong('M is left out: these are the eigenvalues of -C itself', _Q, build=lambda c: c.plain[:c.k]),
+    Wrong('M^-1 stands on both sides (-M^-1 C M^-1), not M^-1/2', f'{_Q}: the square roots of the areas', build=lambda c: c.inverse[:c.k]),
+    Wrong('the eigenvalues are not sorted (np.linalg.eig and eigsh return them in no particular order), so the first k taken are not the k smallest', 'sort them, and the columns with them: order = np.argsort(lam)', when=lambda lam, right, c: _some_of(lam, c) and (not agree(lam, right))),
+    Wrong('the eigenvalues differ from the k smallest of C e = -lam M e on {label}', f'{_Q} and a symmetric solver', when=lambda lam, right, c: True, typical=False),
 ]
 
 E_MISTAKES = [
-    Wrong("E holds the eigenvectors z of Q, not transformed back", "e = M^-1/2 z: E = Z / np.sqrt(m)[:, None]",
-          when=lambda a, right, c: _residual(a[1] / np.sqrt(c.m)[:, None], a[0], c)),
-    Wrong("the back-transform uses M^-1 instead of M^-1/2", "e = M^-1/2 z",
-          when=lambda a, right, c: _residual(a[1] * np.sqrt(c.m)[:, None], a[0], c)),
-    Wrong("the columns of E are not eigenvectors for these lam on {label} (C E + M E diag(lam) is not 0)",
-          "E[:, i] belongs to lam[i]: keep the columns in the order of their eigenvalues",
-          when=lambda a, right, c: not _residual(a[1], a[0], c), typical=False),
-    Wrong("the eigenvectors are normalised in the plain dot product (E^T E = I), not in M (E^T M E = I)",
-          "divide each column by its M-norm, sqrt(e^T M e)",
-          when=lambda a, right, c: np.allclose(np.einsum("ij,ij->j", a[1], a[1]), 1.0, rtol=1e-6)),
-    Wrong("the eigenvectors are not M-normalised: E^T M E is diagonal but not I", "divide each column by "
-          "sqrt(e^T M e)", when=lambda a, right, c: _diagonal(a[1], c)),
-    Wrong("E^T M E is not the identity on {label}: eigenvectors of one repeated eigenvalue are not M-orthogonal",
-          "take an orthonormal basis Z of each eigenspace of Q, as a symmetric solver returns",
-          when=lambda a, right, c: True, typical=False),
+    Wrong('E holds the eigenvectors z of Q, not transformed back', 'e = M^-1/2 z: E = Z / np.sqrt(m)[:, None]', when=lambda a, right, c: _residual(a[1] / np.sqrt(c.m)[:, None], a[0], c)),
+    Wrong('the back-transform uses M^-1 instead of M^-1/2', 'e = M^-1/2 z', when=lambda a, right, c: _residual(a[1] * np.sqrt(c.m)[:, None], a[0], c)),
+    Wrong('the columns of E are not eigenvectors for these lam on {label} (C E + M E diag(lam) is not 0)', 'E[:, i] belongs to lam[i]: keep the columns in the order of their eigenvalues', when=lambda a, right, c: not _residual(a[1], a[0], c), typical=False),
+    Wrong('the eigenvectors are normalised in the plain dot product (E^T E = I), not in M (E^T M E = I)', 'divide each column by its M-norm, sqrt(e^T M e)', when=lambda a, right, c: np.allclose(np.einsum('ij,ij->j', a[1], a[1]), 1.0, rtol=1e-06)),
+    Wrong('the eigenvectors are not M-normalised: E^T M E is diagonal but not I', 'divide each column by sqrt(e^T M e)', when=lambda a, right, c: _diagonal(a[1], c)),
+    Wrong('E^T M E is not the identity on {label}: eigenvectors of one repeated eigenvalue are not M-orthogonal', 'take an orthonormal basis Z of each eigenspace of Q, as a symmetric solver returns', when=lambda a, right, c: True, typical=False),
 ]
 # fmt: on
+
+_SPECTRAL = "eigenpairs eigenbasis spectral_basis SpectralBasis spectral_reconstruction"
 
 
 @exercise(
     "eigenpairs",
-    reread=_REREAD_EIGEN,
-    forbid=(
-        "lessons.spectral.eigenpairs",
-        "lessons.spectral.eigenbasis",
-        "lessons.spectral.spectral_basis",
-        "lessons.spectral.SpectralBasis",
-        "lessons.spectral.spectral_reconstruction",
-        "numerics.eigen.smallest_eigenpairs",
-        "numerics.eigen.shift_invert_lanczos",
-    ),
-    own=("lessons.spectral.eigenbasis", "lessons.spectral.eigenpairs"),
+    reread="section 2 · The discrete eigenproblem",
+    forbid=named("lessons.spectral", _SPECTRAL) + named("numerics.eigen", "smallest_eigenpairs shift_invert_lanczos"),
+    own=named("lessons.spectral", "eigenbasis eigenpairs"),
 )
 def eigenpairs(fn):
     """Check ``fn(M, C, k) -> (lam, E)``: the k smallest pairs of ``C e = -lam M e``, ascending, ``E^T M E = I``."""
     cases = []
-    for (label, V, F), k in zip(_meshes(case_rng()).values(), (6, 6, 4)):
+    for (label, V, F), k in zip(_meshes(case_rng()), (6, 6, 4)):
         M, C = laplacian(V, F)
         m = M.diagonal()
-        cases.append(
-            Case(label, M=M, C=C, k=k).but(
-                m=m, every=_eig(C, 1 / np.sqrt(m))[0], plain=_eig(C, np.ones(len(m)))[0], inverse=_eig(C, 1 / m)[0]
-            )
-        )
-    with refusing(GENERALISED, fn, "reduce to Q = -M^-1/2 C M^-1/2 and use a symmetric solver on Q"):
+        every, plain, inverse = (_eig(C, d)[0] for d in (1 / np.sqrt(m), np.ones(len(m)), 1 / m))
+        cases.append(Case(label, M=M, C=C, k=k).but(m=m, every=every, plain=plain, inverse=inverse))
+    with refusing(GENERALISED, fn, f"reduce to {_Q} and use a symmetric solver on Q"):
         answers = [pair(call(fn, c.M.copy(), c.C.copy(), c.k), len(c.m), c.k) for c in cases]
     judge(LAM_MISTAKES, cases, [lam for lam, _ in answers], right=lambda c: c.every[: c.k])
     ok = lambda a, right, c: _residual(a[1], a[0], c) and np.allclose(_gram(a[1], c), np.eye(c.k), atol=1e-6)  # noqa: E731
@@ -152,37 +108,33 @@ def eigenpairs(fn):
     return [f"{c.label} with k = {c.k}" for c in cases]
 
 
-# --------------------------------------------------------------------------
-# the reconstruction V_k = E_k E_k^T M V
+# ---------------------------------------------------------------- the reconstruction V_k = E_k E_k^T M V
 
 
 def _project(c, k=None, first=0, inner=lambda c, X: c.m[:, None] * X, E=None, left=False):
-    E = c.E if E is None else E
-    Ek = E[:, first : (c.k if k is None else k)]
+    Ek = (c.E if E is None else E)[:, first : (c.k if k is None else k)]
     X = Ek @ (Ek.T @ inner(c, c.V))
     return c.m[:, None] * X if left else X
 
 
 def _basis_of(V, F, weights="cotan", area="barycentric"):
+    """(m, lam, E): the vertex areas and every eigenpair of C e = -lam M e, by the reduction, dense."""
     M, C = laplacian(V, F, weights=weights, area=area)
-    m = M.diagonal()
-    return m, _eig(C, 1 / np.sqrt(m))[1] / np.sqrt(m)[:, None]
+    lam, Z = _eig(C, 1 / np.sqrt(m := M.diagonal()))
+    return m, lam, Z / np.sqrt(m)[:, None]
 
 
 def _boundary_rows(c):
     Cz = laplacian(c.V, c.F)[1].toarray()
     Cz[boundary_vertices(c.F, c.n), :] = 0.0  # C is no longer symmetric: eigh reads its lower triangle
-    E = scipy.linalg.eigh(-Cz, np.diag(c.m))[1]
-    return _project(c, E=E)
+    return _project(c, E=scipy.linalg.eigh(-Cz, np.diag(c.m))[1])
 
 
 def _in_uniform_span(a, c):
     """Whether V_k lies in the span of the uniform eigenvectors up to lam_{k-1}'s whole eigenspace, which
     repeats on a subdivided icosahedron's graph: any basis of a cut eigenspace gives another V_k."""
-    M, C = laplacian(c.V, c.F, weights="uniform")
-    m = M.diagonal()
-    lam, Z = _eig(C, 1 / np.sqrt(m))
-    S = Z[:, lam <= lam[c.k - 1] + 1e-9 * lam[-1]] / np.sqrt(m)[:, None]
+    m, lam, E = _basis_of(c.V, c.F, weights="uniform")
+    S = E[:, lam <= lam[c.k - 1] + 1e-9 * lam[-1]]
     return agree(S @ (S.T @ (m[:, None] * a)), a)
 
 
@@ -193,38 +145,28 @@ def _eig_rows(c):
 
 
 def _other_basis(c, **options):
-    m, E = _basis_of(c.V, c.F, **options)
+    m, _, E = _basis_of(c.V, c.F, **options)
     return E[:, : c.k] @ (E[:, : c.k].T @ (m[:, None] * c.V))
 
 
+_UNIFORM = ("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
+            "laplacian(V, F) with its default weights")  # fmt: skip
 # fmt: off
 RECONSTRUCTION_MISTAKES = [
-    Wrong("the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs",
-          "E^T M E = I, so the coefficients are E_k^T M V", build=lambda c: _project(c, inner=lambda c, X: X)),
-    Wrong("V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)", "c = E_k^T M V",
-          build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None])),
-    Wrong("M multiplies the result (M E_k E_k^T V) instead of V inside the inner product", "V_k = E_k (E_k^T (M V))",
-          build=lambda c: _project(c, inner=lambda c, X: X, left=True)),
-    Wrong("C stands where M belongs in the inner product", "the coefficients are E_k^T M V",
-          build=lambda c: _project(c, inner=lambda c, X: c.C @ X)),
-    Wrong("the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes",
-          "E[:, :k], e_0 included, and E_k^T M V", build=lambda c: _project(c, first=1, inner=lambda c, X: X)),
-    Wrong("the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin",
-          "use E[:, :k], e_0 included", build=lambda c: _project(c, first=1)),
-    Wrong("k is off by one: one eigenvector too few", "E[:, :k] holds e_0 .. e_{k-1}", build=lambda c: _project(c, k=c.k - 1)),
-    Wrong("k is off by one: one eigenvector too many", "E[:, :k] holds e_0 .. e_{k-1}", build=lambda c: _project(c, k=c.k + 1)),
-    Wrong("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
-          "laplacian(V, F) with its default weights", build=lambda c: _other_basis(c, weights="uniform")),
-    Wrong("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
-          "laplacian(V, F) with its default weights", when=lambda a, right, c: _in_uniform_span(a, c)),
-    Wrong("the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked",
-          "laplacian(V, F) with its default area", build=lambda c: _other_basis(c, area="mixed")),
-    Wrong("the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh",
-          "keep every row of C: the natural boundary condition needs no rule", build=_boundary_rows),
-    Wrong("two mistakes: M is left out (the eigenvectors of -C alone), and the rows of the eigenvector matrix are "
-          "sorted and taken where its columns are the eigenvectors", "E[:, order] and E[:, :k] of C e = -lam M e",
-          build=lambda c: _eig_rows(c)),
-    Wrong("V_k differs from the M-orthogonal projection on {label}", "V_k = E_k (E_k^T M V)", typical=False),
+    Wrong('the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs', 'E^T M E = I, so the coefficients are E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: X)),
+    Wrong('V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)', 'c = E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None])),
+    Wrong('M multiplies the result (M E_k E_k^T V) instead of V inside the inner product', 'V_k = E_k (E_k^T (M V))', build=lambda c: _project(c, inner=lambda c, X: X, left=True)),
+    Wrong('C stands where M belongs in the inner product', 'the coefficients are E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: c.C @ X)),
+    Wrong('the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes', 'E[:, :k], e_0 included, and E_k^T M V', build=lambda c: _project(c, first=1, inner=lambda c, X: X)),
+    Wrong('the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin', 'use E[:, :k], e_0 included', build=lambda c: _project(c, first=1)),
+    Wrong('k is off by one: one eigenvector too few', 'E[:, :k] holds e_0 .. e_{k-1}', build=lambda c: _project(c, k=c.k - 1)),
+    Wrong('k is off by one: one eigenvector too many', 'E[:, :k] holds e_0 .. e_{k-1}', build=lambda c: _project(c, k=c.k + 1)),
+    Wrong(*_UNIFORM, build=lambda c: _other_basis(c, weights='uniform')),
+    Wrong(*_UNIFORM, when=lambda a, right, c: _in_uniform_span(a, c)),
+    Wrong('the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked', 'laplacian(V, F) with its default area', build=lambda c: _other_basis(c, area='mixed')),
+    Wrong('the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh', 'keep every row of C: the natural boundary condition needs no rule', build=_boundary_rows),
+    Wrong('two mistakes: M is left out (the eigenvectors of -C alone), and the rows of the eigenvector matrix are sorted and taken where its columns are the eigenvectors', 'E[:, order] and E[:, :k] of C e = -lam M e', build=_eig_rows),
+    Wrong('V_k differs from the M-orthogonal projection on {label}', 'V_k = E_k (E_k^T M V)', typical=False),
 ]
 # fmt: on
 
@@ -237,38 +179,25 @@ def _positions(fn, c):
             raise
         raise Mistake("(M, C) are swapped: laplacian returns M first", "M, C = laplacian(V, F)") from None
     if np.shape(out) == (c.k, 3):
-        raise Mistake(
-            f"the function returned the {c.k} x 3 coefficients E_k^T M V, not the positions",
-            "multiply them back: V_k = E_k c",
-            typical=False,
-        )
+        diagnosis = f"the function returned the {c.k} x 3 coefficients E_k^T M V, not the positions"
+        raise Mistake(diagnosis, "multiply them back: V_k = E_k c", typical=False)
     if np.shape(out) == (c.n, 3) and np.asarray(out).dtype.kind == "f" and not np.isfinite(out).all():
-        raise Mistake(
-            "the positions are NaN, as when (M, C) are swapped: C's diagonal, negative, went in as the "
-            "vertex areas and under a square root",
-            "M, C = laplacian(V, F): M first",
-        )
+        diagnosis = "the positions are NaN, as when (M, C) are swapped: C's diagonal, negative, went in as the "
+        raise Mistake(diagnosis + "vertex areas and under a square root", "M, C = laplacian(V, F): M first")
     return positions(out, c.n)
 
 
 @exercise(
     "spectral_reconstruction",
-    reread=_REREAD,
-    forbid=(
-        "lessons.spectral.spectral_reconstruction",
-        "lessons.spectral.spectral_basis",
-        "lessons.spectral.SpectralBasis",
-    ),
+    reread="section 4 · Reconstruction from the first k eigenvectors",
+    forbid=named("lessons.spectral", "spectral_reconstruction spectral_basis SpectralBasis"),
     allow=("lessons.laplace.laplacian", "lessons.spectral.eigenpairs"),
 )
 def spectral_reconstruction(fn):
     """Check ``fn(V, F, k) -> V_k``: V_k = E_k E_k^T M V with E_k the first k eigenvectors (every k < n)."""
-    meshes = _meshes(case_rng())
-    cases = []
-    for name, k in (("egg", 5), ("egg", 12), ("open", 8)):
-        label, V, F = meshes[name]
-        m, E = _basis_of(V, F)
+    meshes, cases = _meshes(case_rng()), []
+    for (label, V, F), k in ((meshes[0], 5), (meshes[0], 12), (meshes[1], 8)):
+        m, _, E = _basis_of(V, F)
         cases.append(Case(label, V=V, F=F, k=k).but(m=m, E=E, C=laplacian(V, F)[1]))
-    answers = [_positions(fn, c) for c in cases]
-    judge(RECONSTRUCTION_MISTAKES, cases, answers, right=_project)
+    judge(RECONSTRUCTION_MISTAKES, cases, [_positions(fn, c) for c in cases], right=_project)
     return [f"{c.label} with k = {c.k}" for c in cases]

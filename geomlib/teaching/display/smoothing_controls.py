@@ -17,7 +17,7 @@ from ...mesh.geometry import bounding_box_diagonal, enclosed_volume
 from ...mesh.topology import boundary_vertices
 from ...numerics.progress import LARGE_MESH
 from ..experiments.steps import log_positions, log_slider, step_label
-from ..notebook import note
+from ..notebook import graded, note
 from .controls import live, mesh_warnings
 from .viewer import MeshView
 
@@ -106,7 +106,13 @@ def implicit_explorer(V, F, steps, name, iterations, limit):
     # up to 10 STEP, not 100 STEP: 50 steps of that leave a needle too thin to draw
     step_slider = log_slider(value, value / 100, value * 10, step_label(steps.unit), grid)
     positions = log_positions(step_slider)
-    smoother = ImplicitSmoother(V, F).prepare([steps.absolute(name, s) for s in positions], iterations)
+
+    def prepared(step):  # the slider position nearest to ``step``, as an absolute step
+        return steps.absolute(name, positions[np.argmin(np.abs(np.log10(positions / step)))])
+
+    # while nbgrader grades nobody moves the slider: only its starting position is prepared
+    taus = [prepared(step_slider.value)] if graded() else [steps.absolute(name, s) for s in positions]
+    smoother = ImplicitSmoother(V, F).prepare(taus, iterations)
     closed = len(boundary_vertices(F, len(V))) == 0
     vol0, diag = enclosed_volume(V, F), bounding_box_diagonal(V)
     controls = {
@@ -130,7 +136,7 @@ def implicit_explorer(V, F, steps, name, iterations, limit):
     )
 
     def update(step, iterations, keep_volume, operator):
-        tau = steps.absolute(name, positions[np.argmin(np.abs(np.log10(positions / step)))])  # a prepared value
+        tau = prepared(step)
         if operator == "fixed":
             P = smoother.smooth(tau, iterations, keep_volume=keep_volume, progress=False)
         else:

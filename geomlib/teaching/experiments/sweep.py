@@ -30,7 +30,9 @@ from ...lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmooth
 from ...mesh.errors import MeshError, MeshWarning
 from ...mesh.geometry import bounding_box_diagonal
 from ...mesh.validate import check_choice
+from ...numerics import experiment_store
 from ...numerics.cores import CORES
+from ..notebook import graded
 from .steps import absolute_step
 
 __all__ = [
@@ -462,6 +464,11 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
         if not steps or not counts or min(counts) < 1 or min(steps) <= 0:
             raise MeshError("every method needs positive steps and iteration counts of at least 1")
 
+    # while grading, every student's notebook asks for the same comparison: computed once, then read
+    name = experiment_store.key("denoising_comparison", V_clean, F, out.sigmas, int(seed), out.grids)
+    if graded() and _restore(out, experiment_store.load(name)):
+        return out
+
     # one job per (noise level, method): a worker process takes every other one
     jobs = [(i, j) for i in range(len(out.sigmas)) for j in range(len(out.methods))]
 
@@ -488,7 +495,30 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
                 out.noisy[key][i] = value
 
     _run_levels(sweep, rows, put, len(jobs), out, None, workers)
+    if graded():
+        experiment_store.store(name, _arrays(out))
     return out
+
+
+def _arrays(out):
+    """The numbers of a DenoisingComparison as named arrays (for the experiment store)."""
+    arrays = {"limits": out.limits} | {f"noisy-{k}": v for k, v in out.noisy.items()}
+    return arrays | {f"values-{k}-{j}": block for k, v in out.values.items() for j, block in enumerate(v)}
+
+
+def _restore(out, arrays):
+    """Fill ``out`` from stored ``arrays``; False (``out`` untouched) when they are absent or do not fit."""
+    if arrays is None or set(arrays) != set(_arrays(out)):
+        return False
+    if any(arrays[k].shape != v.shape for k, v in _arrays(out).items()):
+        return False
+    out.limits[:] = arrays["limits"]
+    for k, v in out.noisy.items():
+        v[:] = arrays[f"noisy-{k}"]
+    for k, v in out.values.items():
+        for j, block in enumerate(v):
+            block[:] = arrays[f"values-{k}-{j}"]
+    return True
 
 
 def _compare(comparison, out, i, j, seed):
