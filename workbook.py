@@ -174,7 +174,7 @@ def test_workers(args):
     """pytest-xdist options for the test command: one worker per core, unless the arguments
     choose the workers themselves (``-n 0`` runs everything in one process). Each notebook
     file stays whole on one worker (nbval runs a notebook's cells in order in one kernel):
-    pyproject.toml's ``--dist loadfile`` sees to that for every pytest run."""
+    the checkout's conftest.py sees to that for every pytest run (``--dist loadfile``)."""
     if any(a == "-n" or a.startswith(("-n", "--numprocesses")) or "xdist" in a for a in args):
         return []
     return ["-n", "auto"]

@@ -5,7 +5,7 @@ each as the solution cell they would hand in (notebooks 01 and 03) and what the 
 must say. The fast tests run each function-level cheat through the check in this
 process, where it can be refused (a student's interactive check). The slow ones build a
 small nbgrader course (01 and 03, with the course's one configuration line for
-``geomlib.teaching.grading.JudgeExercises``) and let a real ``nbgrader autograde`` grade
+``geomlib.course.grading.JudgeExercises``) and let a real ``nbgrader autograde`` grade
 an honest student, a student with one typical mistake and four students who hand in
 the whole catalogue (four cheats each, other exercises left as released): every cheating exercise
 scores 0 and its feedback names what it did, while the honest student scores full
@@ -26,8 +26,8 @@ import numpy as np
 import pytest
 
 from geomlib import check
+from geomlib.course.grading import CONFIG_LINE
 from geomlib.teaching.check import copies, judge, wire
-from geomlib.teaching.grading import CONFIG_LINE
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))

@@ -24,7 +24,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from geomlib.teaching.grading import CONFIG_LINE
+from geomlib.course.grading import CONFIG_LINE
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))

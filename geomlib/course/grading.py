@@ -10,7 +10,7 @@ the check's passing message. nbgrader's own ``SaveAutoGrades`` then scores those
 outputs, and the feedback page shows them. A course turns it on with one line in its
 ``nbgrader_config.py`` (docs/grading.md)::
 
-    c.Autograde.autograde_preprocessors.insert(1, "geomlib.teaching.grading.JudgeExercises")
+    c.Autograde.autograde_preprocessors.insert(1, "geomlib.course.grading.JudgeExercises")
 
 The verdicts and the copy flags go into the autograded notebook's metadata
 (``metadata.geomlib.grading``) for a class report; ``copy_flags(nb)`` reads them back.
@@ -22,10 +22,10 @@ import nbformat
 from nbgrader.coursedir import CourseDirectory
 from nbgrader.preprocessors import NbGraderPreprocessor
 
-from .check.copies import flag_sentence
-from .check.judge import verdicts
+from ..teaching.check.copies import flag_sentence
+from ..teaching.check.judge import verdicts
 
-CONFIG_LINE = 'c.Autograde.autograde_preprocessors.insert(1, "geomlib.teaching.grading.JudgeExercises")'
+CONFIG_LINE = 'c.Autograde.autograde_preprocessors.insert(1, "geomlib.course.grading.JudgeExercises")'
 
 
 class JudgeExercises(NbGraderPreprocessor):
