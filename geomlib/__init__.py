@@ -62,6 +62,7 @@ _EXPORTS = {
     "mean_curvature": "lessons.curvature",
     "gaussian_curvature": "lessons.curvature",
     "principal_curvatures": "lessons.curvature",
+    "discrete_principal_curvatures": "lessons.curvature",
     "vertex_normals": "mesh.geometry",
     "mean_edge_length": "mesh.geometry",
     "surface_area": "mesh.geometry",
