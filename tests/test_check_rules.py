@@ -42,7 +42,7 @@ SHORTCUTS = {
     "volume_kept": lambda P, F, V: smoothing.volume_rescaled(P, F, V),
     "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
-    "vertex_rms": geomlib.vertex_rms,
+    "denoising_metrics": geomlib.denoising_metrics,
     "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
         V, F, sigma, tau, iterations, seed
     )[0],

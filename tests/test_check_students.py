@@ -1207,24 +1207,117 @@ def noise_corner(V, F, sigma, seed):
     return V + sigma * np.linalg.norm(V.max(axis=0)) * rng.standard_normal(V.shape)
 
 
-# ============================================================================ 07 · vertex_rms
+# ============================================================================ 07 · denoising_metrics
 
 
-@student("vertex_rms")
-def rms_plain(V, V_clean):
+def _unit_normals(X, F):
+    N = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+    return N / np.linalg.norm(N, axis=1)[:, None]
+
+
+@student("denoising_metrics")
+def metrics_loops(V, V_clean, F):
+    d = np.linalg.norm(np.ptp(V_clean, axis=0))
+    rms = np.sqrt(sum(np.dot(p - x, p - x) for p, x in zip(V, V_clean)) / len(V)) / d
+    angles, vol, vol0 = [], 0.0, 0.0
+    for i, j, k in F:
+        n = np.cross(V[j] - V[i], V[k] - V[i])
+        n0 = np.cross(V_clean[j] - V_clean[i], V_clean[k] - V_clean[i])
+        c = np.dot(n, n0) / (np.linalg.norm(n) * np.linalg.norm(n0))
+        angles.append(np.degrees(np.arccos(min(1.0, max(-1.0, c)))))
+        vol += np.dot(V[i], np.cross(V[j], V[k])) / 6
+        vol0 += np.dot(V_clean[i], np.cross(V_clean[j], V_clean[k])) / 6
+    return {"rms": rms, "normal_mean": np.mean(angles), "volume_change": (vol - vol0) / abs(vol0)}
+
+
+@student("denoising_metrics")
+def metrics_arctan2(V, V_clean, F):
+    d = np.sqrt(((V_clean.max(0) - V_clean.min(0)) ** 2).sum())
+    out = {"rms": np.sqrt(np.mean(np.linalg.norm(V - V_clean, axis=1) ** 2)) / d}
+    N = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    N0 = np.cross(V_clean[F[:, 1]] - V_clean[F[:, 0]], V_clean[F[:, 2]] - V_clean[F[:, 0]])
+    sine = np.linalg.norm(np.cross(N, N0), axis=1)
+    out["normal_mean"] = np.rad2deg(np.arctan2(sine, np.einsum("ij,ij->i", N, N0))).mean()
+    vol = np.einsum("ij,ij->", V[F[:, 0]], N) / 6  # x0 . (x1 - x0) x (x2 - x0) = x0 . (x1 x x2)
+    vol0 = np.einsum("ij,ij->", V_clean[F[:, 0]], N0) / 6
+    out["volume_change"] = vol / vol0 - 1
+    return out
+
+
+@student("denoising_metrics", named="radians")
+def metrics_radians(V, V_clean, F):
     d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
-    return np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / d
+    cos = np.sum(_unit_normals(V, F) * _unit_normals(V_clean, F), axis=1)
+    vol = np.linalg.det(V[F]).sum() / 6
+    vol0 = np.linalg.det(V_clean[F]).sum() / 6
+    return {
+        "rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / d,
+        "normal_mean": np.mean(np.arccos(np.clip(cos, -1, 1))),
+        "volume_change": (vol - vol0) / abs(vol0),
+    }
 
 
-@student("vertex_rms", named="3n coordinates")
-def rms_coordinates(V, V_clean):
-    return np.sqrt(np.mean((V - V_clean) ** 2)) / _diag(V_clean)
+@student("denoising_metrics", named="NaN")
+def metrics_unclipped(V, V_clean, F):
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    theta = np.degrees(np.arccos(np.einsum("ij,ij->i", _unit_normals(V, F), _unit_normals(V_clean, F))))
+    vol = np.linalg.det(V[F]).sum() / 6
+    vol0 = np.linalg.det(V_clean[F]).sum() / 6
+    rms = np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / d
+    return {"rms": rms, "normal_mean": theta.mean(), "volume_change": (vol - vol0) / abs(vol0)}
 
 
-@student("vertex_rms", named="noisy mesh's diagonal")
-def rms_noisy_diagonal(V, V_clean):
-    dist = np.linalg.norm(V - V_clean, axis=1)
-    return np.sqrt((dist**2).mean()) / _diag(V)
+@student("denoising_metrics", named="not of unit length")
+def metrics_raw_normals(V, V_clean, F):
+    e2 = ((V - V_clean) ** 2).sum(axis=1)
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    a, b, c = (V[F[:, k]] for k in range(3))
+    a0, b0, c0 = (V_clean[F[:, k]] for k in range(3))
+    dots = (np.cross(b - a, c - a) * np.cross(b0 - a0, c0 - a0)).sum(axis=1)
+    vol, vol0 = (a * np.cross(b, c)).sum() / 6, (a0 * np.cross(b0, c0)).sum() / 6
+    return {
+        "rms": np.sqrt(e2.mean()) / d,
+        "normal_mean": np.degrees(np.arccos(np.clip(dots, -1, 1))).mean(),
+        "volume_change": (vol - vol0) / abs(vol0),
+    }
+
+
+@student("denoising_metrics", named="volume change is absolute")
+def metrics_absolute_volume(V, V_clean, F):
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
+    vol = lambda X: np.sum(X[F[:, 0]] * np.cross(X[F[:, 1]], X[F[:, 2]])) / 6  # noqa: E731
+    return {
+        "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
+        "normal_mean": np.degrees(np.arccos(cos)).mean(),
+        "volume_change": vol(V) - vol(V_clean),
+    }
+
+
+@student("denoising_metrics", named="noisy mesh's diagonal")
+def metrics_noisy_diagonal(V, V_clean, F):
+    d = np.linalg.norm(V.max(axis=0) - V.min(axis=0))  # the mesh being measured
+    cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
+    vol = np.linalg.det(V[F]).sum() / 6
+    vol0 = np.linalg.det(V_clean[F]).sum() / 6
+    return {
+        "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
+        "normal_mean": np.degrees(np.arccos(cos)).mean(),
+        "volume_change": (vol - vol0) / abs(vol0),
+    }
+
+
+@student("denoising_metrics", named="unsigned")
+def metrics_unsigned_volume(V, V_clean, F):
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
+    vol = np.abs(np.linalg.det(V[F])).sum() / 6  # a volume is positive
+    vol0 = np.abs(np.linalg.det(V_clean[F])).sum() / 6
+    return {
+        "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
+        "normal_mean": np.degrees(np.arccos(cos)).mean(),
+        "volume_change": (vol - vol0) / vol0,
+    }
 
 
 # ============================================================================ 07 · denoising_experiment
@@ -1553,14 +1646,28 @@ def noise_unscaled(V, F, sigma, seed):
     return V + np.random.default_rng(seed).normal(scale=sigma, size=V.shape)
 
 
-@student("vertex_rms", named="not rooted")
-def rms_unrooted(V, V_clean):
-    return np.mean(np.sum((V - V_clean) ** 2, axis=1)) / _diag(V_clean) ** 2
+@student("denoising_metrics", named="not rooted")
+def metrics_unrooted(V, V_clean, F):
+    diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    n, n0 = _unit_normals(V, F), _unit_normals(V_clean, F)
+    vols = [np.einsum("ij,ij->", X[F[:, 0]], np.cross(X[F[:, 1]], X[F[:, 2]])) / 6 for X in (V, V_clean)]
+    return {
+        "rms": np.mean(np.sum((V - V_clean) ** 2, axis=1)) / diag**2,
+        "normal_mean": np.rad2deg(np.arccos(np.clip(np.sum(n * n0, axis=1), -1, 1))).mean(),
+        "volume_change": (vols[0] - vols[1]) / abs(vols[1]),
+    }
 
 
-@student("vertex_rms", named="mean of the distances")
-def rms_mean_distance(V, V_clean):
-    return np.linalg.norm(V - V_clean, axis=1).mean() / _diag(V_clean)
+@student("denoising_metrics", named="divided by the new volume")
+def metrics_over_new_volume(V, V_clean, F):
+    diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    n, n0 = _unit_normals(V, F), _unit_normals(V_clean, F)
+    vol, vol0 = (np.linalg.det(X[F]).sum() / 6 for X in (V, V_clean))
+    return {
+        "rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / diag,
+        "normal_mean": np.rad2deg(np.arccos(np.clip(np.sum(n * n0, axis=1), -1, 1))).mean(),
+        "volume_change": (vol - vol0) / vol,
+    }
 
 
 @student("denoising_experiment", named="the error is absolute")
