@@ -85,6 +85,7 @@ _EXPORTS = {
     "volume_rescaled": "lessons.smoothing",
     "ExplicitSmoother": "lessons.smoothing",
     "ImplicitSmoother": "lessons.smoothing",
+    "taubin_smoothing": "lessons.smoothing",
     # noise and evaluation
     "add_noise": "lessons.noise",
     "denoising_experiment": "lessons.noise",
