@@ -714,65 +714,147 @@ def eigen_no_back_transform(M, C, k):
 
 
 @student("spectral_reconstruction")
-def reconstruct_generalised(V, F, k):
+def reconstruct_generalised(V, F, ks, solve):
     M, C = laplacian(V, F)
-    lam, E = sla.eigh(-C.toarray(), M.toarray())
-    Ek = E[:, :k]
-    return Ek @ (Ek.T @ (M @ V))
+    lam, E = sla.eigh(-C.toarray(), M.toarray())  # my own solve, all of them
+    A = M.diagonal()
+    bbox = np.linalg.norm(np.max(V, axis=0) - np.min(V, axis=0))
+    recons = []
+    errors = []
+    for k in ks:
+        Ek = E[:, :k]
+        Vk = Ek @ (Ek.T @ (M @ V))
+        recons.append(Vk)
+        diff = V - Vk
+        errors.append(np.sqrt((A * (diff**2).sum(axis=1)).sum() / A.sum()) / bbox)
+    return recons, errors
 
 
 @student("spectral_reconstruction")
-def reconstruct_by_hand(V, F, k):
+def reconstruct_stacked(V, F, ks, solve):
     M, C = laplacian(V, F)
     m = M.diagonal()
-    Q = -(C.toarray() / np.sqrt(m)[:, None]) / np.sqrt(m)[None, :]
-    lam, Z = np.linalg.eigh(Q)
-    E = Z[:, :k] / np.sqrt(m)[:, None]
+    K = max(ks)
+    lam, E = solve(M, C, K)
     coeffs = E.T @ (m[:, None] * V)
-    return E @ coeffs
+    out = np.zeros((len(ks), V.shape[0], 3))
+    for j, k in enumerate(ks):
+        out[j] = E[:, :k] @ coeffs[:k]
+    diffs = out - V[None, :, :]
+    sq = np.einsum("i,jid->j", m, diffs**2)
+    diag = np.sqrt(((V.max(0) - V.min(0)) ** 2).sum())
+    return out, np.sqrt(sq / m.sum()) / diag
 
 
-@student("spectral_reconstruction", named="the rows of the boundary vertices are zeroed")
-def reconstruct_boundary_rows_zeroed(V, F, k):
+@student("spectral_reconstruction")
+def reconstruct_centred_first(V, F, ks, solve):
     M, C = laplacian(V, F)
-    C = C.tolil()
-    counts = {}
-    for f in F:
-        for a in range(3):
-            e = (min(f[a], f[a - 1]), max(f[a], f[a - 1]))
-            counts[e] = counts.get(e, 0) + 1
-    boundary = sorted({v for e, c in counts.items() if c == 1 for v in e})
-    for b in boundary:
-        C[b, :] = 0  # "fix" the boundary
-    vals, vecs = sla.eigh(-C.toarray(), M.toarray())
-    basis = vecs[:, :k]
-    return basis @ basis.T @ M @ V
+    centre = V.mean(axis=0)
+    P = V - centre  # centre it first, add it back at the end
+    results, errs = [], []
+    for k in ks:
+        lam, E = solve(M, C, k)  # one solve per k: slower but simple
+        Pk = E @ (E.T @ M @ P) + centre
+        results.append(Pk)
+        d = V - Pk
+        rms = np.sqrt(np.sum(M @ (d * d)) / M.diagonal().sum())
+        errs.append(rms / np.linalg.norm(np.ptp(V, axis=0)))
+    return results, np.array(errs)
 
 
-@student("spectral_reconstruction", named="the constant eigenvector e_0 is dropped and the plain inner product")
-def reconstruct_drop_constant_plain(V, F, k):
+@student("spectral_reconstruction", named="the mean is taken out twice")
+def reconstruct_centred_and_dropped(V, F, ks, solve):
     M, C = laplacian(V, F)
-    w, E = sla.eigh(-C.toarray(), M.toarray())
-    E = E[:, 1:k]  # skip the trivial eigenvector
-    return E @ (E.T @ V)
-
-
-@student("spectral_reconstruction", named="rows of the eigenvector matrix")
-def reconstruct_eig_rows(V, F, k):
-    M, C = laplacian(V, F)
-    vals, vecs = np.linalg.eig(-C.toarray())
-    idx = np.argsort(vals.real)
-    vecs = vecs.real[idx]  # sorts the rows, not the columns
-    U = vecs[:, :k]
-    return U @ (U.T @ V)
+    mu = np.mean(V, axis=0)
+    Vc = V - mu
+    lam, E = solve(M, C, max(ks))
+    area = M.diagonal().sum()
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    Vs, err = [], []
+    for k in ks:
+        B = E[:, 1:k]  # e_0 is the constant, and V is centred already
+        Vk = mu + B @ (B.T @ (M @ Vc))
+        Vs.append(Vk)
+        err.append(np.sqrt(np.sum(M.diagonal()[:, None] * (V - Vk) ** 2) / area) / diag)
+    return Vs, err
 
 
 @student("spectral_reconstruction", named="plain dot product")
-def reconstruct_plain_dot(V, F, k):
+def reconstruct_plain_dot(V, F, ks, solve):
     M, C = laplacian(V, F)
-    lam, E = sla.eigh(-C.toarray(), M.toarray())
-    phi = E[:, :k]
-    return phi @ (phi.T @ V)
+    lam, E = solve(M, C, max(ks))
+    diag = np.linalg.norm(V.max(0) - V.min(0))
+    recs, errs = [], []
+    for k in ks:
+        phi = E[:, :k]
+        Vk = phi @ (phi.T @ V)
+        recs.append(Vk)
+        errs.append(np.sqrt(np.sum(M.diagonal() * np.sum((V - Vk) ** 2, axis=1)) / M.diagonal().sum()) / diag)
+    return recs, errs
+
+
+@student("spectral_reconstruction", named="the vertices are weighted equally")
+def reconstruct_euclidean_error(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    lam, E = solve(M, C, max(ks))
+    c = E.T @ M @ V
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    Vks = [E[:, :k] @ c[:k] for k in ks]
+    err = [np.sqrt(np.mean(np.sum((V - Vk) ** 2, axis=1))) / diag for Vk in Vks]  # RMS over the vertices
+    return Vks, np.array(err)
+
+
+@student("spectral_reconstruction", named="not divided by the bounding-box diagonal")
+def reconstruct_error_not_relative(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    A = M.diagonal()
+    lam, E = solve(M, C, max(ks))
+    recon = []
+    error = []
+    for k in ks:
+        Vk = E[:, :k] @ (E[:, :k].T @ (A[:, None] * V))
+        recon.append(Vk)
+        error.append(np.sqrt(np.sum(A[:, None] * (V - Vk) ** 2) / np.sum(A)))
+    return recon, error
+
+
+@student("spectral_reconstruction", named="the square root is missing")
+def reconstruct_error_squared(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    lam, E = solve(M, C, max(ks))
+    A = M.diagonal()
+    box = V.max(axis=0) - V.min(axis=0)
+    diag = np.sqrt(box @ box)
+    res = [E[:, :k] @ (E[:, :k].T @ (M @ V)) for k in ks]
+    errs = [np.sum(A[:, None] * (V - R) ** 2) / A.sum() / diag for R in res]  # mean squared distance
+    return res, errs
+
+
+@student("spectral_reconstruction", named="one eigenvector too many")
+def reconstruct_k_plus_one(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    lam, E = solve(M, C, max(ks) + 1)
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    out, errs = [], []
+    for k in ks:
+        Ek = E[:, : k + 1]  # e_0 .. e_k
+        Vk = Ek @ Ek.T @ M @ V
+        out.append(Vk)
+        errs.append(np.sqrt(np.sum(M @ ((V - Vk) ** 2)) / M.diagonal().sum()) / diag)
+    return out, errs
+
+
+@student("spectral_reconstruction", named="the uniform operator")
+def reconstruct_uniform(V, F, ks, solve):
+    n = len(V)
+    A = np.zeros((n, n))
+    for i, j, l in F:
+        A[i, j] = A[j, i] = A[j, l] = A[l, j] = A[i, l] = A[l, i] = 1
+    deg = A.sum(axis=1)
+    lam, E = sla.eigh(np.diag(deg) - A, np.diag(deg))
+    diag = np.linalg.norm(V.max(0) - V.min(0))
+    Vs = [E[:, :k] @ (E[:, :k].T @ (deg[:, None] * V)) for k in ks]
+    return Vs, [np.sqrt(np.sum(deg[:, None] * (V - X) ** 2) / deg.sum()) / diag for X in Vs]
 
 
 # ============================================================================ 05 · lam_max
@@ -1555,25 +1637,6 @@ def eigen_eigsh_default(M, C, k):
 def eigen_unit_columns(M, C, k):
     lam, E = eigen_reduction_numpy(M, C, k)
     return lam, E / np.linalg.norm(E, axis=0)
-
-
-@student("spectral_reconstruction", named="the uniform operator")
-def reconstruct_uniform(V, F, k):
-    n = len(V)
-    A = np.zeros((n, n))
-    for i, j, l in F:
-        A[i, j] = A[j, i] = A[j, l] = A[l, j] = A[i, l] = A[l, i] = 1
-    deg = A.sum(axis=1)
-    lam, E = sla.eigh(np.diag(deg) - A, np.diag(deg))
-    Ek = E[:, :k]
-    return Ek @ (Ek.T @ (deg[:, None] * V))
-
-
-@student("spectral_reconstruction", named="one eigenvector too many")
-def reconstruct_k_plus_one(V, F, k):
-    M, C = laplacian(V, F)
-    lam, E = sla.eigh(-C.toarray(), M.toarray(), subset_by_index=[0, k])
-    return E @ E.T @ M @ V
 
 
 @student("lam_max")
