@@ -457,3 +457,44 @@ def test_geomlibs_own_sweep_is_refused_and_a_stub_is_not_written():
 
     assert_diagnosed(check.denoising_sweep(stub), "not written yet")
     assert_diagnosed(check.denoising_sweep(lambda *a: 0.5), "triple")
+
+
+# --- Taubin's pairs: shrink, inflate, boundary held, the uniform operator ---------------
+
+
+def taubin_reference(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = geomlib.laplacian(V, F, "uniform")
+    moving = np.setdiff1d(np.arange(len(V)), geomlib.boundary_vertices(F, len(V)))
+    P = V.copy()
+    for _ in range(pairs):
+        for tau in (tau_shrink, tau_inflate):
+            P[moving] += tau * (C @ P)[moving] / M.diagonal()[moving, None]
+    return P
+
+
+def test_reference_taubin_passes_and_a_stub_is_not_written():
+    assert check.taubin_smoothing(taubin_reference).passed
+    assert_diagnosed(check.taubin_smoothing(lambda *args: (_ for _ in ()).throw(NotImplementedError())), "not written")
+
+
+def test_every_taubin_mistake_is_named_when_handed_in():
+    from diagnoses import replaying
+
+    from geomlib.teaching.check.denoising import TAUBIN_MISTAKES, _taubin_cases
+    from geomlib.teaching.check.result import _SEED
+
+    for seed in (1, 2):
+        _SEED.update(asked=seed, used=None)
+        cases = _taubin_cases()
+        for entry in (w for w in TAUBIN_MISTAKES if w.build is not None):
+            result = check.taubin_smoothing(replaying(cases, entry.build), seed=seed)
+            assert_diagnosed(result, entry.diagnosis, "Reread section 6 · Taubin's filter, yours")
+            assert result.partial
+
+
+def test_taubin_of_the_wrong_shape_or_a_nan_earns_nothing():
+    for out in (np.zeros((3, 3)), np.full((16, 3), np.nan)):
+        result = check.taubin_smoothing(
+            lambda V, F, a, b, k, out=out: np.resize(out, V.shape) if out.shape[0] == 16 else out
+        )
+        assert not result.passed and not result.partial

@@ -47,6 +47,9 @@ SHORTCUTS = {
         V, F, sigma, tau, iterations, seed
     )[0],
     "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
+    "taubin_smoothing": lambda V, F, tau_shrink, tau_inflate, pairs: geomlib.taubin_smoothing(
+        V, F, tau_shrink, tau_inflate, pairs
+    ),
     "normal_curvature": lambda forms, a, b, c, u, v, phi: symbolic.forms_normal_curvature(forms, a, b, c, u, v, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
     "principal_curvatures": lambda I, II: symbolic.forms_principal_curvatures(I, II),

@@ -18,7 +18,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from geomlib import check, implicit_smoothing, laplacian
+from geomlib import boundary_vertices, check, implicit_smoothing, laplacian
 from geomlib.lessons.laplace import edge_lengths
 
 SEED = 20261128  # the checks' cases, drawn as one run of a class would draw them
@@ -1495,6 +1495,110 @@ def sweep_explicit(W, F, V_clean, taus, iterations):
     E = np.array(E)
     i, k = np.unravel_index(E.argmin(), E.shape)
     return taus[i], k, E
+
+
+# ============================================================================ 07 · taubin_smoothing
+
+
+@student("taubin_smoothing")
+def taubin_rows(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, weights="uniform")
+    inner = np.setdiff1d(np.arange(len(V)), boundary_vertices(F, len(V)))
+    L = (sp.diags(1 / M.diagonal()) @ C).tocsr()[inner]  # the rows that move
+    P = V.copy()
+    for _ in range(pairs):
+        for tau in (tau_shrink, tau_inflate):
+            P[inner] = P[inner] + tau * (L @ P)
+    return P
+
+
+@student("taubin_smoothing")
+def taubin_neighbour_average(V, F, tau_shrink, tau_inflate, pairs):
+    n = len(V)
+    edges = np.sort(np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    e, count = np.unique(edges, axis=0, return_counts=True)
+    A = sp.coo_matrix((np.ones(2 * len(e)), (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
+    valence = np.asarray(A.sum(axis=1)).ravel()
+    fixed = np.zeros(n, bool)
+    fixed[e[count == 1].ravel()] = True  # an edge of one face lies on the boundary
+    P = V.astype(float).copy()
+    for _ in range(pairs):
+        for t in (tau_shrink, tau_inflate):
+            umbrella = (A @ P) / valence[:, None] - P  # the mean of the neighbours minus the vertex
+            P = np.where(fixed[:, None], P, P + t * umbrella)
+    return P
+
+
+@student("taubin_smoothing", named="wrong sign")
+def taubin_minus_mu(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, "uniform")
+    free = np.ones(len(V), bool)
+    free[boundary_vertices(F, len(V))] = False
+    m = M.diagonal()[free, None]
+    P = V.copy()
+    for _ in range(pairs):
+        P[free] += tau_shrink * (C @ P)[free] / m
+        P[free] -= tau_inflate * (C @ P)[free] / m  # inflate: the other direction
+    return P
+
+
+@student("taubin_smoothing", named="counted instead of pairs")
+def taubin_alternating_steps(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, "uniform")
+    b = boundary_vertices(F, len(V))
+    P = V.copy()
+    for k in range(pairs):
+        tau = tau_shrink if k % 2 == 0 else tau_inflate
+        step = tau * (C @ P) / M.diagonal()[:, None]
+        step[b] = 0
+        P = P + step
+    return P
+
+
+@student("taubin_smoothing", named="boundary vertices moved")
+def taubin_free_boundary(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, weights="uniform")
+    Minv = sp.diags(1.0 / M.diagonal())
+    P = V.copy()
+    for _ in range(pairs):
+        P = P + tau_shrink * (Minv @ (C @ P))
+        P = P + tau_inflate * (Minv @ (C @ P))
+    return P
+
+
+@student("taubin_smoothing", named="M^-1 is missing")
+def taubin_no_mass(V, F, tau_shrink, tau_inflate, pairs):
+    _, C = laplacian(V, F, "uniform")
+    keep = boundary_vertices(F, len(V))
+    P = V.copy()
+    for _ in range(2 * pairs):
+        tau = tau_inflate if _ % 2 else tau_shrink
+        Q = P + tau * (C @ P)
+        Q[keep] = V[keep]
+        P = Q
+    return P
+
+
+@student("taubin_smoothing", named="same P")
+def taubin_simultaneous(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, "uniform")
+    inner = np.setdiff1d(np.arange(len(V)), boundary_vertices(F, len(V)))
+    P = V.copy()
+    for _ in range(pairs):
+        lap = (C @ P) / M.diagonal()[:, None]
+        P[inner] += tau_shrink * lap[inner] + tau_inflate * lap[inner]  # both from this P
+    return P
+
+
+@student("taubin_smoothing", named="cotangent weights")
+def taubin_cotan(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F)  # the default weights
+    inner = np.setdiff1d(np.arange(len(V)), boundary_vertices(F, len(V)))
+    P = V.copy()
+    for _ in range(pairs):
+        P[inner] += tau_shrink * (C @ P)[inner] / M.diagonal()[inner, None]
+        P[inner] += tau_inflate * (C @ P)[inner] / M.diagonal()[inner, None]
+    return P
 
 
 # ============================================================================ a second batch, written before the

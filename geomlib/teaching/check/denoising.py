@@ -15,6 +15,9 @@ shrinkage alone) is compared exactly and tells N iterations from N - 1 or N + 1.
 
 ``denoising_sweep(fn)``: ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` on two noisy
 icospheres, every entry of the table exactly.
+
+``taubin_smoothing(fn)``: ``fn(V, F, tau_shrink, tau_inflate, pairs) -> P``, Taubin's pairs on the uniform operator
+with the boundary held, against :func:`geomlib.taubin_smoothing` on an open bump and a closed icosphere.
 """
 
 import functools
@@ -23,12 +26,13 @@ from pathlib import Path
 import numpy as np
 
 from ...lessons.metrics import face_normal_angles, vertex_rms, volume_change
+from ...lessons.smoothing import taubin_smoothing as taubin_pairs
 from ...mesh.geometry import bounding_box_diagonal, face_cross, face_volumes, mean_edge_length
-from .catalogue import Case, Wrong, answer, judge, named, number
-from .meshes import irregular_bipyramid, jittered_icosphere, placed
+from .catalogue import Case, Wrong, answer, judge, named, number, positions, run
+from .meshes import bump_4x4, irregular_bipyramid, jittered_icosphere, placed
 from .result import Mistake, call, case_rng, exercise
 
-__all__ = ["add_noise", "denoising_metrics", "denoising_experiment", "denoising_sweep"]
+__all__ = ["add_noise", "denoising_metrics", "denoising_experiment", "denoising_sweep", "taubin_smoothing"]
 
 
 def _grid(nx, ny, spacing, height):
@@ -438,3 +442,75 @@ def denoising_sweep(fn):
     answers = [_sweep_flat(answer(fn, c), c) for c in cases]
     judge(SWEEP_MISTAKES, cases, answers, right=lambda c: _sweep_flat(c.right, c))
     return [c.label + f" ({len(c.taus)} steps, {c.iterations} iterations)" for c in cases]
+
+
+# ------------------------------------------------------------------ Taubin's pairs
+# an open bump (its boundary held) and a closed icosphere, placed anew; pairs and steps chosen so that every
+# wrong count and step of the catalogue differs from the right one on one of them
+_TAUBIN_CASES = (
+    ("a 4 x 4 bump (open)", bump_4x4, 0.5, -0.53, 3),
+    ("a jittered icosphere", jittered_icosphere, 0.33, -0.34, 4),
+)
+
+
+def _taubin_cases():
+    rng, cases = case_rng(), []
+    for label, mesh, tau_shrink, tau_inflate, pairs in _TAUBIN_CASES:
+        V, F = placed(*mesh(), rng, jitter=0.1)
+        cases.append(Case(label, V=V, F=F, tau_shrink=tau_shrink, tau_inflate=tau_inflate, pairs=pairs))
+    return [c.but(right=taubin_pairs(c.V, c.F, c.tau_shrink, c.tau_inflate, c.pairs)) for c in cases]
+
+
+def _pairs_run(c, taus=None, weights="uniform", held=True, divide=True, rebuild=False):
+    """Explicit steps of ``taus`` (default: the pairs of the case) on (c.V, c.F), done right or in a wrong way."""
+    from ...lessons.laplace import laplacian
+    from ...mesh.topology import boundary_vertices
+
+    taus = [c.tau_shrink, c.tau_inflate] * c.pairs if taus is None else taus
+    move = np.ones(len(c.V), bool)
+    move[boundary_vertices(c.F, len(c.V))] = not held
+    P, (M, C) = c.V.copy(), laplacian(c.V, c.F, weights)
+    for tau in taus:
+        M, C = laplacian(P, c.F, weights) if rebuild else (M, C)
+        m = M.diagonal() if divide else np.ones(len(P))
+        P[move] += tau * (C @ P)[move] / m[move, None]
+    return P
+
+
+def _steps(c, shrink, inflate, pairs=None):
+    return [shrink, inflate] * (c.pairs if pairs is None else pairs)
+
+
+# fmt: off
+TAUBIN_MISTAKES = [
+    Wrong("the inflate step has the wrong sign: both steps shrink", "tau_inflate < 0 is given negative: add tau_inflate M^-1 C P, as the shrink step adds tau_shrink M^-1 C P", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, -c.tau_inflate))),
+    Wrong("the same step twice: each pair is two shrink steps of tau_shrink", "the second step of a pair uses tau_inflate", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_shrink))),
+    Wrong("only the shrink step: the inflate step is missing", "a pair is a step of tau_shrink, then one of tau_inflate", build=lambda c: _pairs_run(c, [c.tau_shrink] * c.pairs)),
+    Wrong("both steps are taken from the same P (P + (tau_shrink + tau_inflate) M^-1 C P): the inflate step must act on the shrunk positions", "update P with the shrink step, then apply the inflate step to that new P", build=lambda c: _pairs_run(c, [c.tau_shrink + c.tau_inflate] * c.pairs)),
+    Wrong("the sign of the Laplacian is flipped: the shrink step inflates", "P + tau M^-1 C P with C negative semidefinite (its diagonal negative)", build=lambda c: _pairs_run(c, _steps(c, -c.tau_shrink, -c.tau_inflate))),
+    Wrong("steps were counted instead of pairs: `pairs` explicit steps in all", "repeat the pair (shrink, then inflate) `pairs` times: 2 * pairs steps", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_inflate)[: c.pairs])),
+    Wrong("one pair short", "range(pairs), from 0: pairs repetitions", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_inflate, c.pairs - 1))),
+    Wrong("one pair too many", "range(pairs): exactly pairs repetitions", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_inflate, c.pairs + 1))),
+    Wrong("the boundary vertices moved: they are held where they are", "update only the interior vertices (not those of geomlib.boundary_vertices(F, n))", build=lambda c: _pairs_run(c, held=False)),
+    Wrong("M^-1 is missing: P + tau C P, not P + tau M^-1 C P", "divide each row of C P by the valence M_ii", build=lambda c: _pairs_run(c, divide=False)),
+    Wrong("cotangent weights: Taubin's filter here uses the uniform operator", 'geomlib.laplacian(V, F, "uniform")', build=lambda c: _pairs_run(c, weights="cotan")),
+    Wrong("cotangent weights, rebuilt from the moved mesh at every step: Taubin's filter here uses the uniform operator", 'geomlib.laplacian(V, F, "uniform"), built once (it depends on F alone)', build=lambda c: _pairs_run(c, weights="cotan", rebuild=True)),
+    Wrong("the positions differ from Taubin's pairs on {label}", "pairs times: P <- P + tau_shrink M^-1 C P, then P <- P + tau_inflate M^-1 C P, boundary held", typical=False),
+]
+# fmt: on
+
+
+@exercise(
+    "taubin_smoothing",
+    reread="section 6 · Taubin's filter, yours",
+    forbid=named("lessons.smoothing", "taubin_smoothing explicit_step explicit_smoothing ExplicitSmoother") + _SWEEPS,
+    allow=("lessons.laplace.laplacian", "mesh.topology.boundary_vertices"),
+)
+def taubin_smoothing(fn):
+    """Check ``fn(V, F, tau_shrink, tau_inflate, pairs) -> P`` against geomlib's :func:`taubin_smoothing`."""
+    cases = _taubin_cases()
+    answers = run(
+        fn, cases, lambda out, n: positions(out, n, nan_hint="a step past the limit diverges: check the signs")
+    )
+    judge(TAUBIN_MISTAKES, cases, answers, right=lambda c: c.right)
+    return [f"{c.label}, {c.pairs} pairs ({c.tau_shrink}, {c.tau_inflate})" for c in cases]
