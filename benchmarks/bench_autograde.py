@@ -1,10 +1,12 @@
 """Autograde seconds per student of the seven exercise notebooks, against the floor.
 
-    python benchmarks/bench_autograde.py [--students 2] [--workers 2] [--json out.json]
+    python benchmarks/bench_autograde.py [--students 2] [--workers 2] [--json out.json] [--no-judge]
 
 Builds a course folder in a temporary directory (notebooks 01-07 as one assignment,
-``nbgrader generate_assignment``), hands in ``--students`` full solutions, and measures in
-one run, so that the machine's load moves every figure alike:
+``nbgrader generate_assignment``), configured as docs/grading.md configures a course (the
+grading judge's preprocessor included; ``--no-judge`` leaves it out, as the figures before
+it were measured), hands in ``--students`` full solutions, and measures in one run, so that
+the machine's load moves every figure alike:
 
 * the floor: for each notebook, a fresh kernel started by nbclient (as nbgrader's Execute
   does) running one cell with every import the notebook makes, summed over the seven;
@@ -34,6 +36,7 @@ import nbformat  # noqa: E402
 from nbclient import NotebookClient  # noqa: E402
 
 from geomlib.course.autograde import autograde_class  # noqa: E402
+from geomlib.course.grading import CONFIG_LINE  # noqa: E402
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("0[1-7]_*.ipynb"))
 ASSIGNMENT = "bench"
@@ -78,13 +81,13 @@ def nbgrader(course, *args):
                    capture_output=True)  # fmt: skip
 
 
-def make_course(folder, students):
+def make_course(folder, students, judge=True):
     folder.mkdir()
     (folder / "nbgrader_config.py").write_text(
         "c = get_config()\n"
         f"c.CourseDirectory.root = {str(folder)!r}\n"
         "c.CourseDirectory.course_id = 'bench'\n"
-        "c.Execute.timeout = 600\n"
+        "c.Execute.timeout = 600\n" + (f"{CONFIG_LINE}\n" if judge else "")
     )
     source = folder / "source" / ASSIGNMENT
     source.mkdir(parents=True)
@@ -103,12 +106,13 @@ def main(argv=None):
     parser.add_argument("--students", type=int, default=2)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--no-judge", action="store_true", help="grade without the grading judge (docs/grading.md)")
     args = parser.parse_args(argv)
     os.environ.pop("GEOMLIB_STRICT_CLAIMS", None)
     load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench-autograde-") as scratch:
         serial, parallel = Path(scratch) / "serial", Path(scratch) / "parallel"
-        make_course(serial, args.students)
+        make_course(serial, args.students, judge=not args.no_judge)
         shutil.copytree(serial, parallel)
         (parallel / "nbgrader_config.py").write_text(
             (serial / "nbgrader_config.py").read_text().replace(str(serial), str(parallel))
@@ -124,7 +128,7 @@ def main(argv=None):
         floor_after = floor_seconds()
     floor = (floor_before + floor_after) / 2
     ratio = serial_s / floor
-    print(f"load average at the start: {load:.1f} (2 cores)")
+    print(f"load average at the start: {load:.1f} (2 cores); the grading judge {'left out' if args.no_judge else 'on'}")
     print(
         f"floor (kernel start + imports, 7 notebooks): {floor:.1f} s ({floor_before:.1f} s before, {floor_after:.1f} s after)"
     )
@@ -133,7 +137,8 @@ def main(argv=None):
     print(f"serial / floor: {ratio:.2f}x (goal at most {GOAL:.1f}x): {'met' if ratio <= GOAL else 'NOT met'}")
     if args.json:
         figures = {"load": load, "floor_s": floor, "serial_s": serial_s, "parallel_s": parallel_s, "ratio": ratio}
-        args.json.write_text(json.dumps(figures | {"workers": args.workers, "students": args.students}, indent=1))
+        setting = {"workers": args.workers, "students": args.students, "judge": not args.no_judge}
+        args.json.write_text(json.dumps(figures | setting, indent=1))
     return 0
 
 

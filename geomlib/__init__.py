@@ -62,6 +62,7 @@ _EXPORTS = {
     "mean_curvature": "lessons.curvature",
     "gaussian_curvature": "lessons.curvature",
     "principal_curvatures": "lessons.curvature",
+    "discrete_principal_curvatures": "lessons.curvature",
     "vertex_normals": "mesh.geometry",
     "mean_edge_length": "mesh.geometry",
     "surface_area": "mesh.geometry",
@@ -84,6 +85,7 @@ _EXPORTS = {
     "volume_rescaled": "lessons.smoothing",
     "ExplicitSmoother": "lessons.smoothing",
     "ImplicitSmoother": "lessons.smoothing",
+    "taubin_smoothing": "lessons.smoothing",
     # noise and evaluation
     "add_noise": "lessons.noise",
     "denoising_experiment": "lessons.noise",

@@ -109,29 +109,84 @@ def rms_reference(V, V_clean):
     return float(np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1)))) / bounding_box_diagonal(V_clean)
 
 
-def _e2(V, V_clean):
-    return np.sum((V - V_clean) ** 2, axis=1)
+def _unit(X, F):
+    N = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+    return N / np.linalg.norm(N, axis=1, keepdims=True)
 
 
-WRONG_RMS = {
-    "not relative": (lambda V, W: float(np.sqrt(_e2(V, W).mean())), "not relative"),
-    "mean of norms": (
-        lambda V, W: float(np.sqrt(_e2(V, W)).mean()) / bounding_box_diagonal(W),
-        "mean of the distances",
-    ),
-    "not rooted": (lambda V, W: float(_e2(V, W).mean()) / bounding_box_diagonal(W), "not rooted"),
-    "squared ratio": (lambda V, W: float(_e2(V, W).mean()) / bounding_box_diagonal(W) ** 2, "not rooted"),
-    "summed": (lambda V, W: float(np.sqrt(_e2(V, W).sum())) / bounding_box_diagonal(W), "summed"),
+def _volume(X, F):
+    return float(np.sum(X[F[:, 0]] * np.cross(X[F[:, 1]], X[F[:, 2]]))) / 6
+
+
+def metrics_from(rms=rms_reference, angle=lambda cos: np.degrees(np.arccos(np.clip(cos, -1, 1))).mean(),
+                 change=lambda vol, vol_clean: (vol - vol_clean) / abs(vol_clean)):  # fmt: skip
+    """The three measures, each part replaceable by a wrong one."""
+
+    def fn(V, V_clean, F):
+        cos = np.sum(_unit(V, F) * _unit(V_clean, F), axis=1)
+        return {
+            "rms": rms(V, V_clean),
+            "normal_mean": angle(cos),
+            "volume_change": change(_volume(V, F), _volume(V_clean, F)),
+        }
+
+    return fn
+
+
+WRONG_METRICS = {
+    "not relative": (metrics_from(rms=lambda V, W: rms_reference(V, W) * bounding_box_diagonal(W)), "not relative"),
     "noisy diagonal": (
-        lambda V, W: float(np.sqrt(_e2(V, W).mean())) / bounding_box_diagonal(V),
+        metrics_from(rms=lambda V, W: rms_reference(V, W) * bounding_box_diagonal(W) / bounding_box_diagonal(V)),
         "noisy mesh's diagonal",
     ),
-    "over coordinates": (
-        lambda V, W: float(np.sqrt(np.mean((V - W) ** 2))) / bounding_box_diagonal(W),
-        "3n coordinates",
-    ),
-    "per vertex": (lambda V, W: np.sqrt(_e2(V, W)) / bounding_box_diagonal(W), "not one number"),
+    "radians": (metrics_from(angle=lambda cos: np.arccos(np.clip(cos, -1, 1)).mean()), "radians"),
+    "unclipped": (metrics_from(angle=lambda cos: np.degrees(np.arccos(cos + 1e-15)).mean()), "NaN"),
+    "summed angles": (metrics_from(angle=lambda cos: np.degrees(np.arccos(np.clip(cos, -1, 1))).sum()), "summed"),
+    "absolute volume": (metrics_from(change=lambda vol, vol_clean: vol - vol_clean), "volume change is absolute"),
+    "ratio": (metrics_from(change=lambda vol, vol_clean: vol / vol_clean), "ratio vol / vol_clean"),
+    "flipped": (metrics_from(change=lambda vol, vol_clean: (vol_clean - vol) / vol_clean), "sign of the volume"),
+    "a tuple": (lambda V, W, F: tuple(metrics_from()(V, W, F).values()), "did not return a dict"),
 }
+
+
+def test_reference_metrics_pass_and_are_geomlibs():
+    assert check.denoising_metrics(metrics_from()).passed
+    V, F = geomlib.load_mesh(geomlib.data_path("sphere.obj"))
+    W = geomlib.add_noise(V, F, 0.01, 3)
+    mine, theirs = metrics_from()(W, V, F), geomlib.denoising_metrics(W, V, F)
+    assert all(np.isclose(mine[k], theirs[k], rtol=1e-9) for k in mine)
+
+
+def test_the_measures_have_exact_answers_on_a_scaled_tetrahedron():
+    V_clean = np.array([[0.0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]]) + 5.0  # away from the origin
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    c = V_clean.mean(axis=0)
+    m = metrics_from()(c + 0.5 * (V_clean - c), V_clean, F)  # halved about its centroid: normals kept, volume / 8
+    assert m["normal_mean"] == pytest.approx(0.0, abs=1e-6) and m["volume_change"] == pytest.approx(-7 / 8)
+    assert m["rms"] == pytest.approx(0.5 * np.sqrt(np.mean(np.sum((V_clean - c) ** 2, axis=1))) / np.sqrt(21))
+
+
+@pytest.mark.parametrize("name", sorted(WRONG_METRICS))
+def test_wrong_metrics_are_diagnosed(name):
+    fn, phrase = WRONG_METRICS[name]
+    assert_diagnosed(check.denoising_metrics(fn), phrase, "Reread section 3 · The measures, yours")
+
+
+def test_every_catalogue_entry_is_named_when_handed_in():
+    from diagnoses import replaying
+
+    from geomlib.teaching.check.denoising import MEASURE_MISTAKES, _measure_cases
+    from geomlib.teaching.check.result import _SEED
+
+    for seed in (1, 2):
+        _SEED.update(asked=seed, used=None)
+        cases = _measure_cases()
+        for entry in (w for w in MEASURE_MISTAKES if w.build is not None):
+            wrong = replaying(
+                cases,
+                lambda c, entry=entry: dict(zip(("rms", "normal_mean", "volume_change"), entry.build(c) * c.scale)),
+            )
+            assert_diagnosed(check.denoising_metrics(wrong, seed=seed), entry.diagnosis)
 
 
 def test_reference_noise_passes():
@@ -153,25 +208,7 @@ def test_wrong_noise_is_diagnosed(name):
     assert_diagnosed(check.add_noise(fn), phrase, "Reread section 2 · The noise, yours")
 
 
-def test_reference_rms_passes():
-    result = check.vertex_rms(rms_reference)
-    assert result.passed, result.message
-
-
-def test_rms_has_exact_answer_on_the_tetrahedron():
-    V_clean = np.array([[0.0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]])
-    V = V_clean.copy()
-    V[1, 0] += 3.0
-    assert rms_reference(V, V_clean) == pytest.approx(1.5 / np.sqrt(21))
-
-
-@pytest.mark.parametrize("name", sorted(WRONG_RMS))
-def test_wrong_rms_is_diagnosed(name):
-    fn, phrase = WRONG_RMS[name]
-    assert_diagnosed(check.vertex_rms(fn), phrase, "Reread section 3 · The error, yours")
-
-
-@pytest.mark.parametrize("exercise", [check.add_noise, check.vertex_rms, check.denoising_experiment])
+@pytest.mark.parametrize("exercise", [check.add_noise, check.denoising_metrics, check.denoising_experiment])
 def test_stub_is_not_written_yet(exercise):
     def stub(*args):
         raise NotImplementedError("Your turn")
@@ -182,7 +219,7 @@ def test_stub_is_not_written_yet(exercise):
 def test_strict_mode_raises_for_written_wrong_function(monkeypatch):
     monkeypatch.setenv("GEOMLIB_STRICT_CLAIMS", "1")
     with pytest.raises(check.CheckFailed, match="not relative"):
-        check.vertex_rms(WRONG_RMS["not relative"][0])
+        check.denoising_metrics(WRONG_METRICS["not relative"][0])
 
 
 # --- the experiment: noise, implicit smoothing, the error against the clean mesh ---------------
@@ -237,7 +274,7 @@ WRONG_EXPERIMENTS = {
         experiment(seeded, lambda P, W, V: _rms(P, W) / bounding_box_diagonal(V)),
         "against the noisy mesh",
     ),
-    "against the noisy mesh, over its own diagonal (my_vertex_rms(P, W))": (
+    "against the noisy mesh, over its own diagonal (my_denoising_metrics(P, W, F))": (
         experiment(seeded, lambda P, W, V: _rms(P, W) / bounding_box_diagonal(W)),
         "against the noisy mesh W",
     ),
@@ -420,3 +457,44 @@ def test_geomlibs_own_sweep_is_refused_and_a_stub_is_not_written():
 
     assert_diagnosed(check.denoising_sweep(stub), "not written yet")
     assert_diagnosed(check.denoising_sweep(lambda *a: 0.5), "triple")
+
+
+# --- Taubin's pairs: shrink, inflate, boundary held, the uniform operator ---------------
+
+
+def taubin_reference(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = geomlib.laplacian(V, F, "uniform")
+    moving = np.setdiff1d(np.arange(len(V)), geomlib.boundary_vertices(F, len(V)))
+    P = V.copy()
+    for _ in range(pairs):
+        for tau in (tau_shrink, tau_inflate):
+            P[moving] += tau * (C @ P)[moving] / M.diagonal()[moving, None]
+    return P
+
+
+def test_reference_taubin_passes_and_a_stub_is_not_written():
+    assert check.taubin_smoothing(taubin_reference).passed
+    assert_diagnosed(check.taubin_smoothing(lambda *args: (_ for _ in ()).throw(NotImplementedError())), "not written")
+
+
+def test_every_taubin_mistake_is_named_when_handed_in():
+    from diagnoses import replaying
+
+    from geomlib.teaching.check.denoising import TAUBIN_MISTAKES, _taubin_cases
+    from geomlib.teaching.check.result import _SEED
+
+    for seed in (1, 2):
+        _SEED.update(asked=seed, used=None)
+        cases = _taubin_cases()
+        for entry in (w for w in TAUBIN_MISTAKES if w.build is not None):
+            result = check.taubin_smoothing(replaying(cases, entry.build), seed=seed)
+            assert_diagnosed(result, entry.diagnosis, "Reread section 6 · Taubin's filter, yours")
+            assert result.partial
+
+
+def test_taubin_of_the_wrong_shape_or_a_nan_earns_nothing():
+    for out in (np.zeros((3, 3)), np.full((16, 3), np.nan)):
+        result = check.taubin_smoothing(
+            lambda V, F, a, b, k, out=out: np.resize(out, V.shape) if out.shape[0] == 16 else out
+        )
+        assert not result.passed and not result.partial

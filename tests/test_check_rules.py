@@ -33,7 +33,7 @@ SHORTCUTS = {
     "mean_curvature": lambda V, F, M, C: geomlib.mean_curvature(V, F, "uniform", signed=True, boundary="nan"),
     "cotangent_matrix": lambda l, F: intrinsic_cotangent_matrix(l, F),
     "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
-    "spectral_reconstruction": lambda V, F, k: geomlib.spectral_reconstruction(V, F, k, cache=False),
+    "spectral_reconstruction": lambda V, F, ks, solve: spectral.spectral_reconstructions(V, F, ks, solve),
     "eigenpairs": lambda M, C, k: spectral.eigenpairs(M, C, k),
     "lam_max": lambda M, C: eigen.largest_eigenvalue(
         -(sp.diags(M.diagonal() ** -0.5) @ C @ sp.diags(M.diagonal() ** -0.5))
@@ -42,11 +42,14 @@ SHORTCUTS = {
     "volume_kept": lambda P, F, V: smoothing.volume_rescaled(P, F, V),
     "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
-    "vertex_rms": geomlib.vertex_rms,
+    "denoising_metrics": geomlib.denoising_metrics,
     "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
         V, F, sigma, tau, iterations, seed
     )[0],
     "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
+    "taubin_smoothing": lambda V, F, tau_shrink, tau_inflate, pairs: geomlib.taubin_smoothing(
+        V, F, tau_shrink, tau_inflate, pairs
+    ),
     "normal_curvature": lambda forms, a, b, c, u, v, phi: symbolic.forms_normal_curvature(forms, a, b, c, u, v, phi),
     "fundamental_forms": lambda a, b, c, u, v: symbolic.ellipsoid_forms(a, b, c, u, v),
     "principal_curvatures": lambda I, II: symbolic.forms_principal_curvatures(I, II),

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from geomlib import check, laplacian
-from geomlib.teaching.check.spectral import E_MISTAKES, LAM_MISTAKES, RECONSTRUCTION_MISTAKES
+from geomlib.teaching.check.spectral import E_MISTAKES, ERROR_MISTAKES, LAM_MISTAKES, POSITION_MISTAKES
 
 
 @pytest.fixture(autouse=True)
@@ -119,88 +119,122 @@ def test_a_generalised_solver_is_refused_however_it_is_imported():
         assert not result.partial and f"calls {name} with a second matrix" in result.message, result.message
 
 
-# --------------------------------------------------------------------------- the reconstruction
+# --------------------------------------------------------------------------- the reconstructions and their errors
 
 
-def projection(
-    V,
-    F,
-    k,
-    weights="cotan",
-    area="barycentric",
-    first=0,
-    extra=0,
-    inner="M",
-    zero_boundary=False,
-    out="positions",
-    swap=False,
-):
-    """A learner's V_k with the named changes (dense basis of the reduction)."""
+def study(V, F, ks, solve, weights="cotan", area="barycentric", first=0, extra=0, inner="M", zero_boundary=False,
+          swap=False, centre=None, each=False, own=False, error="right", out="lists"):  # fmt: skip
+    """A learner's reconstructions V_k for each k of ks and their errors, with the named changes."""
     M, C = laplacian(V, F, weights=weights, area=area)
-    if swap:
-        M, C = C, M
     m = M.diagonal()
-    C = C.toarray()
-    if zero_boundary:
-        edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-        once, count = np.unique(edges, axis=0, return_counts=True)
-        C[np.unique(once[count == 1]), :] = 0.0  # the boundary vertices' rows
-        E = la.eigh(-C, np.diag(m))[1]
+    if zero_boundary or own:  # the learner's own dense solve, not the one handed in
+        C = C.toarray()
+        if zero_boundary:
+            edges = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+            once, count = np.unique(edges, axis=0, return_counts=True)
+            C[np.unique(once[count == 1]), :] = 0.0  # the boundary vertices' rows
+        E = la.eigh(-C, np.diag(m))[1] if zero_boundary else reduced(M, sp.csr_matrix(C), max(ks))[1]
     else:
-        d = 1 / np.sqrt(m)
-        E = d[:, None] * np.linalg.eigh(-(d[:, None] * C * d[None, :]))[1]
-    E = E[:, first : k + extra]
-    W = {"M": m[:, None] * V, "plain": V, "left": V, "inverse": V / m[:, None], "C": C @ V}[inner]
-    c = E.T @ W
-    if out == "coefficients":
-        return c
-    return m[:, None] * (E @ (E.T @ V)) if inner == "left" else E @ c
+        E = solve(C, M, max(ks))[1] if swap else solve(M, C, max(ks) + max(extra, 0))[1]
+    mean = V.mean(axis=0)
+    X = V - mean if centre else V
+    W = {"M": m[:, None] * X, "plain": X, "left": X, "inverse": X / m[:, None]}[inner]
+    V_ks = []
+    for k in ks:
+        Ek = (solve(M, C, k + extra)[1] if each else E)[:, first : k + extra]
+        Y = m[:, None] * (Ek @ (Ek.T @ X)) if inner == "left" else Ek @ (Ek.T @ W)
+        V_ks.append(Y + mean if centre == "back" else Y)
+    gaps, d = [V - Y for Y in V_ks], np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    norms = np.array([np.sqrt(np.sum(m[:, None] * g**2)) for g in gaps])
+    err = {
+        "right": norms / np.sqrt(m.sum()) / d,
+        "not relative": norms,
+        "no diagonal": norms / np.sqrt(m.sum()),
+        "squared": norms**2 / m.sum() / d,
+        "Euclidean": np.array([np.linalg.norm(g) for g in gaps]) / d,
+        "centred": norms / np.sqrt(np.sum(m[:, None] * (V - mean) ** 2)),
+        "shifted": norms / np.sqrt(m.sum()) / d + 0.01 * np.arange(len(ks)),
+    }[error]
+    if out == "arrays":
+        return np.stack(V_ks), err
+    return (V_ks, list(err)) if out == "lists" else V_ks
 
 
-def eig_rows(V, F, k):
-    """np.linalg.eig of -C alone, its eigenvector matrix sorted by rows: M left out, rows for columns."""
-    w, U = np.linalg.eig(-laplacian(V, F)[1].toarray())
-    basis = U.real[np.argsort(w.real)][:, :k]
-    return basis @ (basis.T @ V)
-
-
-RECONSTRUCTION_LEARNERS = {
-    "the plain dot product E_k^T V": lambda V, F, k: projection(V, F, k, inner="plain"),
-    "V is divided by the vertex areas": lambda V, F, k: projection(V, F, k, inner="inverse"),
-    "M multiplies the result": lambda V, F, k: projection(V, F, k, inner="left"),
-    "C stands where M belongs": lambda V, F, k: projection(V, F, k, inner="C"),
-    "dropped and the plain inner product is used": lambda V, F, k: projection(V, F, k, first=1, inner="plain"),
-    "the constant eigenvector e_0 (lam = 0) is left out": lambda V, F, k: projection(V, F, k, first=1),
-    "one eigenvector too few": lambda V, F, k: projection(V, F, k, extra=-1),
-    "one eigenvector too many": lambda V, F, k: projection(V, F, k, extra=1),
-    "the uniform operator": lambda V, F, k: projection(V, F, k, weights="uniform"),
-    "the mixed (Voronoi) vertex areas": lambda V, F, k: projection(V, F, k, area="mixed"),
-    "the rows of the boundary vertices are zeroed": lambda V, F, k: projection(V, F, k, zero_boundary=True),
-    "(M, C) are swapped": lambda V, F, k: projection(V, F, k, swap=True),
-    "the rows of the eigenvector matrix are sorted": eig_rows,
-    "differs from the M-orthogonal projection": lambda V, F, k: 1.01 * projection(V, F, k),
+STUDY_CORRECT = {
+    "one solve, lists": study,
+    "arrays": lambda V, F, ks, solve: study(V, F, ks, solve, out="arrays"),
+    "one solve per k": lambda V, F, ks, solve: study(V, F, ks, solve, each=True),
+    "centred and the mean added back": lambda V, F, ks, solve: study(V, F, ks, solve, centre="back"),
+    "its own solve by the reduction": lambda V, F, ks, solve: study(V, F, ks, solve, own=True),
 }
 
+STUDY_LEARNERS = {
+    "the plain dot product E_k^T V": dict(inner="plain"),
+    "V is divided by the vertex areas": dict(inner="inverse"),
+    "M multiplies the result": dict(inner="left"),
+    "the constant eigenvector e_0 (lam = 0) is left out": dict(first=1),
+    "the mean is taken out twice": dict(centre="back", first=1),
+    "the mean is not added back": dict(centre="away"),
+    "one eigenvector too few": dict(extra=-1),
+    "one eigenvector too many": dict(extra=1),
+    "the uniform operator": dict(weights="uniform"),
+    "the mixed (Voronoi) vertex areas": dict(area="mixed"),
+    "the rows of the boundary vertices are zeroed": dict(zero_boundary=True),
+    "(M, C) are swapped": dict(swap=True),
+    "the errors are not relative": dict(error="not relative"),
+    "not divided by the bounding-box diagonal": dict(error="no diagonal"),
+    "the square root is missing": dict(error="squared"),
+    "weighted equally (the Euclidean norm)": dict(error="Euclidean"),
+    "right up to one factor": dict(error="centred"),
+    "the errors differ from": dict(error="shifted"),
+}
+NOT_TYPICAL_STUDY = {"differs from the M-orthogonal projection", "the errors differ from"}
 
-def test_the_reconstruction_passes():
-    assert check.spectral_reconstruction.evaluate(projection).passed
+
+@pytest.mark.parametrize("name", STUDY_CORRECT)
+def test_correct_studies_pass(name):
+    result = check.spectral_reconstruction.evaluate(STUDY_CORRECT[name])
+    assert result.passed, result.message
 
 
-@pytest.mark.parametrize("name", RECONSTRUCTION_LEARNERS)
-def test_each_reconstruction_mistake_is_named(name):
-    result = check.spectral_reconstruction.evaluate(RECONSTRUCTION_LEARNERS[name])
+@pytest.mark.parametrize("name", [*STUDY_LEARNERS, "differs from the M-orthogonal projection"])
+def test_each_study_mistake_is_named(name):
+    if name in STUDY_LEARNERS:
+        learner = lambda V, F, ks, solve: study(V, F, ks, solve, **STUDY_LEARNERS[name])  # noqa: E731
+    else:
+        learner = lambda V, F, ks, solve: ([1.01 * Y for Y in study(V, F, ks, solve)[0]], study(V, F, ks, solve)[1])  # noqa: E731
+    result = check.spectral_reconstruction.evaluate(learner)
     assert not result.passed and name in result.message, result.message
-    assert result.partial == (name != "differs from the M-orthogonal projection"), result.message
+    assert result.partial == (name not in NOT_TYPICAL_STUDY), result.message
 
 
-def test_the_coefficients_returned_are_named_but_earn_nothing():
-    result = check.spectral_reconstruction.evaluate(lambda V, F, k: projection(V, F, k, out="coefficients"))
-    assert not result.passed and not result.partial and "coefficients" in result.message, result.message
+def test_the_eigenpairs_come_from_the_solve_handed_in_however_often_it_is_called():
+    calls = []
+
+    def counting(V, F, ks, solve):
+        def counted(M, C, k):
+            calls.append(k)
+            return solve(M, C, k)
+
+        return study(V, F, ks, counted, each=True)
+
+    assert check.spectral_reconstruction.evaluate(counting).passed
+    assert sorted(set(calls)) == [1, 3, 4, 8, 12]  # ks = [1, 4, 12] and [3, 8], once per k
+
+
+def test_a_study_of_the_wrong_shape_earns_nothing():
+    for learner in (
+        lambda V, F, ks, solve: study(V, F, ks, solve, out="positions"),  # the V_k alone
+        lambda V, F, ks, solve: (study(V, F, ks, solve)[0][:1], study(V, F, ks, solve)[1][:1]),  # the first k only
+        lambda V, F, ks, solve: (study(V, F, ks, solve)[0], np.zeros((len(ks), 3))),  # errors per coordinate
+    ):
+        result = check.spectral_reconstruction.evaluate(learner)
+        assert not result.passed and not result.partial, result.message
 
 
 @pytest.mark.parametrize(
     "catalogue, learners",
-    [(LAM_MISTAKES + E_MISTAKES, EIGEN_LEARNERS), (RECONSTRUCTION_MISTAKES, RECONSTRUCTION_LEARNERS)],
+    [(LAM_MISTAKES + E_MISTAKES, EIGEN_LEARNERS), (POSITION_MISTAKES + ERROR_MISTAKES, STUDY_LEARNERS)],
 )
 def test_every_entry_of_a_catalogue_has_a_learner_here(catalogue, learners):
     for entry in catalogue:
@@ -221,4 +255,4 @@ def test_a_stub_is_not_written_yet(name):
 def test_the_checks_pass_whatever_the_seed():
     for seed in (0, 1, 2):
         assert check.eigenpairs.evaluate(reduced, seed=seed).passed
-        assert check.spectral_reconstruction.evaluate(projection, seed=seed).passed
+        assert check.spectral_reconstruction.evaluate(study, seed=seed).passed

@@ -18,7 +18,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from geomlib import check, implicit_smoothing, laplacian
+from geomlib import boundary_vertices, check, implicit_smoothing, laplacian
 from geomlib.lessons.laplace import edge_lengths
 
 SEED = 20261128  # the checks' cases, drawn as one run of a class would draw them
@@ -657,6 +657,103 @@ def mixed_halves_swapped(V, F):
     return A
 
 
+# ============================================================================ 03 · discrete_principal_curvatures
+
+
+@student("discrete_principal_curvatures")
+def principal_face_loop(V, F, M, C, deficit):
+    n = len(V)
+    normal = np.zeros((n, 3))
+    for a, b, c in F:
+        normal[[a, b, c]] += np.cross(V[b] - V[a], V[c] - V[a])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    area = M.diagonal()
+    lap = (C @ V) / area[:, None]
+    k1, k2 = np.zeros(n), np.zeros(n)
+    for i in range(n):
+        H = -0.5 * lap[i].dot(normal[i])
+        K = deficit[i] / area[i]
+        disc = max(H * H - K, 0.0) if not np.isnan(K) else np.nan
+        k1[i], k2[i] = H + np.sqrt(disc), H - np.sqrt(disc)
+    return k1, k2
+
+
+@student("discrete_principal_curvatures")
+def principal_sparse_incidence(V, F, M, C, deficit):
+    m = len(F)
+    faces_at = sp.csr_matrix((np.ones(3 * m), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(len(V), m))
+    n_f = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n_v = faces_at @ n_f
+    n_v = n_v / np.sqrt((n_v**2).sum(axis=1, keepdims=True))
+    Minv = sp.diags(1.0 / M.diagonal())
+    H = -0.5 * ((Minv @ C @ V) * n_v).sum(axis=1)
+    K = Minv @ deficit
+    delta = np.clip(H**2 - K, 0, None)
+    return np.vstack([H + np.sqrt(delta), H - np.sqrt(delta)])
+
+
+@student("discrete_principal_curvatures", named="H is unsigned")
+def principal_norm_of_laplacian(V, F, M, C, deficit):
+    A = M.diagonal()
+    H = 0.5 * np.linalg.norm(C @ V, axis=1) / A  # the mean curvature normal's length
+    K = deficit / A
+    s = np.sqrt(np.maximum(H**2 - K, 0))
+    return H + s, H - s
+
+
+@student("discrete_principal_curvatures", named="is not clamped")
+def principal_no_clamp(V, F, M, C, deficit):
+    normals = np.zeros(V.shape)
+    for c in range(3):
+        e1 = V[F[:, (c + 1) % 3]] - V[F[:, c]]
+        e2 = V[F[:, (c + 2) % 3]] - V[F[:, c]]
+        np.add.at(normals, F[:, c], np.cross(e1, e2))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    H = -0.5 * np.einsum("ij,ij->i", sp.diags(1 / M.diagonal()) @ (C @ V), normals)
+    K = deficit / M.diagonal()
+    r = np.sqrt(H**2 - K)
+    return H + r, H - r
+
+
+@student("discrete_principal_curvatures", named="kappa_1 < kappa_2")
+def principal_swapped_and_integrated(V, F, M, C, deficit):
+    N = np.zeros((len(V), 3))
+    for tri in F:
+        i, j, k = tri
+        N[tri] += np.cross(V[j] - V[i], V[k] - V[i])
+    N = N / np.linalg.norm(N, axis=1)[:, None]
+    H = -0.5 * np.sum((C @ V) / M.diagonal()[:, None] * N, axis=1)
+    K = deficit  # the angle deficit is the Gaussian curvature
+    root = np.sqrt(np.maximum(H * H - K, 0))
+    return H - root, H + root
+
+
+@student("discrete_principal_curvatures", named="have values at boundary vertices")
+def principal_nan_to_num(V, F, M, C, deficit):
+    cr = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    nrm = np.zeros_like(V)
+    for c in range(3):
+        np.add.at(nrm, F[:, c], cr)
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    H = -0.5 * np.einsum("ij,ij->i", (C @ V) / M.diagonal()[:, None], nrm)
+    K = np.nan_to_num(deficit) / M.diagonal()  # the NaNs gave warnings
+    d = np.sqrt(np.maximum(H**2 - K, 0.0))
+    return H + d, H - d
+
+
+@student("discrete_principal_curvatures", named="with a sign: the part of M^-1 C x along the surface")
+def principal_meyer_magnitude(V, F, M, C, deficit):
+    # Meyer et al.: kappa_H = 1/2 |K(x_i)|, the mean curvature normal's length, its sign from the normal
+    K_vec = -(C @ V) / M.diagonal()[:, None]
+    n = np.zeros_like(V)
+    for corner in range(3):
+        np.add.at(n, F[:, corner], np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]))
+    H = 0.5 * np.linalg.norm(K_vec, axis=1) * np.sign(np.sum(K_vec * n, axis=1))
+    kG = deficit / M.diagonal()
+    sq = np.sqrt(np.maximum(H**2 - kG, 0))
+    return H + sq, H - sq
+
+
 # ============================================================================ 04 · eigenpairs
 
 
@@ -714,65 +811,147 @@ def eigen_no_back_transform(M, C, k):
 
 
 @student("spectral_reconstruction")
-def reconstruct_generalised(V, F, k):
+def reconstruct_generalised(V, F, ks, solve):
     M, C = laplacian(V, F)
-    lam, E = sla.eigh(-C.toarray(), M.toarray())
-    Ek = E[:, :k]
-    return Ek @ (Ek.T @ (M @ V))
+    lam, E = sla.eigh(-C.toarray(), M.toarray())  # my own solve, all of them
+    A = M.diagonal()
+    bbox = np.linalg.norm(np.max(V, axis=0) - np.min(V, axis=0))
+    recons = []
+    errors = []
+    for k in ks:
+        Ek = E[:, :k]
+        Vk = Ek @ (Ek.T @ (M @ V))
+        recons.append(Vk)
+        diff = V - Vk
+        errors.append(np.sqrt((A * (diff**2).sum(axis=1)).sum() / A.sum()) / bbox)
+    return recons, errors
 
 
 @student("spectral_reconstruction")
-def reconstruct_by_hand(V, F, k):
+def reconstruct_stacked(V, F, ks, solve):
     M, C = laplacian(V, F)
     m = M.diagonal()
-    Q = -(C.toarray() / np.sqrt(m)[:, None]) / np.sqrt(m)[None, :]
-    lam, Z = np.linalg.eigh(Q)
-    E = Z[:, :k] / np.sqrt(m)[:, None]
+    K = max(ks)
+    lam, E = solve(M, C, K)
     coeffs = E.T @ (m[:, None] * V)
-    return E @ coeffs
+    out = np.zeros((len(ks), V.shape[0], 3))
+    for j, k in enumerate(ks):
+        out[j] = E[:, :k] @ coeffs[:k]
+    diffs = out - V[None, :, :]
+    sq = np.einsum("i,jid->j", m, diffs**2)
+    diag = np.sqrt(((V.max(0) - V.min(0)) ** 2).sum())
+    return out, np.sqrt(sq / m.sum()) / diag
 
 
-@student("spectral_reconstruction", named="the rows of the boundary vertices are zeroed")
-def reconstruct_boundary_rows_zeroed(V, F, k):
+@student("spectral_reconstruction")
+def reconstruct_centred_first(V, F, ks, solve):
     M, C = laplacian(V, F)
-    C = C.tolil()
-    counts = {}
-    for f in F:
-        for a in range(3):
-            e = (min(f[a], f[a - 1]), max(f[a], f[a - 1]))
-            counts[e] = counts.get(e, 0) + 1
-    boundary = sorted({v for e, c in counts.items() if c == 1 for v in e})
-    for b in boundary:
-        C[b, :] = 0  # "fix" the boundary
-    vals, vecs = sla.eigh(-C.toarray(), M.toarray())
-    basis = vecs[:, :k]
-    return basis @ basis.T @ M @ V
+    centre = V.mean(axis=0)
+    P = V - centre  # centre it first, add it back at the end
+    results, errs = [], []
+    for k in ks:
+        lam, E = solve(M, C, k)  # one solve per k: slower but simple
+        Pk = E @ (E.T @ M @ P) + centre
+        results.append(Pk)
+        d = V - Pk
+        rms = np.sqrt(np.sum(M @ (d * d)) / M.diagonal().sum())
+        errs.append(rms / np.linalg.norm(np.ptp(V, axis=0)))
+    return results, np.array(errs)
 
 
-@student("spectral_reconstruction", named="the constant eigenvector e_0 is dropped and the plain inner product")
-def reconstruct_drop_constant_plain(V, F, k):
+@student("spectral_reconstruction", named="the mean is taken out twice")
+def reconstruct_centred_and_dropped(V, F, ks, solve):
     M, C = laplacian(V, F)
-    w, E = sla.eigh(-C.toarray(), M.toarray())
-    E = E[:, 1:k]  # skip the trivial eigenvector
-    return E @ (E.T @ V)
-
-
-@student("spectral_reconstruction", named="rows of the eigenvector matrix")
-def reconstruct_eig_rows(V, F, k):
-    M, C = laplacian(V, F)
-    vals, vecs = np.linalg.eig(-C.toarray())
-    idx = np.argsort(vals.real)
-    vecs = vecs.real[idx]  # sorts the rows, not the columns
-    U = vecs[:, :k]
-    return U @ (U.T @ V)
+    mu = np.mean(V, axis=0)
+    Vc = V - mu
+    lam, E = solve(M, C, max(ks))
+    area = M.diagonal().sum()
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    Vs, err = [], []
+    for k in ks:
+        B = E[:, 1:k]  # e_0 is the constant, and V is centred already
+        Vk = mu + B @ (B.T @ (M @ Vc))
+        Vs.append(Vk)
+        err.append(np.sqrt(np.sum(M.diagonal()[:, None] * (V - Vk) ** 2) / area) / diag)
+    return Vs, err
 
 
 @student("spectral_reconstruction", named="plain dot product")
-def reconstruct_plain_dot(V, F, k):
+def reconstruct_plain_dot(V, F, ks, solve):
     M, C = laplacian(V, F)
-    lam, E = sla.eigh(-C.toarray(), M.toarray())
-    phi = E[:, :k]
-    return phi @ (phi.T @ V)
+    lam, E = solve(M, C, max(ks))
+    diag = np.linalg.norm(V.max(0) - V.min(0))
+    recs, errs = [], []
+    for k in ks:
+        phi = E[:, :k]
+        Vk = phi @ (phi.T @ V)
+        recs.append(Vk)
+        errs.append(np.sqrt(np.sum(M.diagonal() * np.sum((V - Vk) ** 2, axis=1)) / M.diagonal().sum()) / diag)
+    return recs, errs
+
+
+@student("spectral_reconstruction", named="the vertices are weighted equally")
+def reconstruct_euclidean_error(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    lam, E = solve(M, C, max(ks))
+    c = E.T @ M @ V
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    Vks = [E[:, :k] @ c[:k] for k in ks]
+    err = [np.sqrt(np.mean(np.sum((V - Vk) ** 2, axis=1))) / diag for Vk in Vks]  # RMS over the vertices
+    return Vks, np.array(err)
+
+
+@student("spectral_reconstruction", named="not divided by the bounding-box diagonal")
+def reconstruct_error_not_relative(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    A = M.diagonal()
+    lam, E = solve(M, C, max(ks))
+    recon = []
+    error = []
+    for k in ks:
+        Vk = E[:, :k] @ (E[:, :k].T @ (A[:, None] * V))
+        recon.append(Vk)
+        error.append(np.sqrt(np.sum(A[:, None] * (V - Vk) ** 2) / np.sum(A)))
+    return recon, error
+
+
+@student("spectral_reconstruction", named="the square root is missing")
+def reconstruct_error_squared(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    lam, E = solve(M, C, max(ks))
+    A = M.diagonal()
+    box = V.max(axis=0) - V.min(axis=0)
+    diag = np.sqrt(box @ box)
+    res = [E[:, :k] @ (E[:, :k].T @ (M @ V)) for k in ks]
+    errs = [np.sum(A[:, None] * (V - R) ** 2) / A.sum() / diag for R in res]  # mean squared distance
+    return res, errs
+
+
+@student("spectral_reconstruction", named="one eigenvector too many")
+def reconstruct_k_plus_one(V, F, ks, solve):
+    M, C = laplacian(V, F)
+    lam, E = solve(M, C, max(ks) + 1)
+    diag = np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+    out, errs = [], []
+    for k in ks:
+        Ek = E[:, : k + 1]  # e_0 .. e_k
+        Vk = Ek @ Ek.T @ M @ V
+        out.append(Vk)
+        errs.append(np.sqrt(np.sum(M @ ((V - Vk) ** 2)) / M.diagonal().sum()) / diag)
+    return out, errs
+
+
+@student("spectral_reconstruction", named="the uniform operator")
+def reconstruct_uniform(V, F, ks, solve):
+    n = len(V)
+    A = np.zeros((n, n))
+    for i, j, l in F:
+        A[i, j] = A[j, i] = A[j, l] = A[l, j] = A[i, l] = A[l, i] = 1
+    deg = A.sum(axis=1)
+    lam, E = sla.eigh(np.diag(deg) - A, np.diag(deg))
+    diag = np.linalg.norm(V.max(0) - V.min(0))
+    Vs = [E[:, :k] @ (E[:, :k].T @ (deg[:, None] * V)) for k in ks]
+    return Vs, [np.sqrt(np.sum(deg[:, None] * (V - X) ** 2) / deg.sum()) / diag for X in Vs]
 
 
 # ============================================================================ 05 · lam_max
@@ -1125,24 +1304,117 @@ def noise_corner(V, F, sigma, seed):
     return V + sigma * np.linalg.norm(V.max(axis=0)) * rng.standard_normal(V.shape)
 
 
-# ============================================================================ 07 · vertex_rms
+# ============================================================================ 07 · denoising_metrics
 
 
-@student("vertex_rms")
-def rms_plain(V, V_clean):
+def _unit_normals(X, F):
+    N = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+    return N / np.linalg.norm(N, axis=1)[:, None]
+
+
+@student("denoising_metrics")
+def metrics_loops(V, V_clean, F):
+    d = np.linalg.norm(np.ptp(V_clean, axis=0))
+    rms = np.sqrt(sum(np.dot(p - x, p - x) for p, x in zip(V, V_clean)) / len(V)) / d
+    angles, vol, vol0 = [], 0.0, 0.0
+    for i, j, k in F:
+        n = np.cross(V[j] - V[i], V[k] - V[i])
+        n0 = np.cross(V_clean[j] - V_clean[i], V_clean[k] - V_clean[i])
+        c = np.dot(n, n0) / (np.linalg.norm(n) * np.linalg.norm(n0))
+        angles.append(np.degrees(np.arccos(min(1.0, max(-1.0, c)))))
+        vol += np.dot(V[i], np.cross(V[j], V[k])) / 6
+        vol0 += np.dot(V_clean[i], np.cross(V_clean[j], V_clean[k])) / 6
+    return {"rms": rms, "normal_mean": np.mean(angles), "volume_change": (vol - vol0) / abs(vol0)}
+
+
+@student("denoising_metrics")
+def metrics_arctan2(V, V_clean, F):
+    d = np.sqrt(((V_clean.max(0) - V_clean.min(0)) ** 2).sum())
+    out = {"rms": np.sqrt(np.mean(np.linalg.norm(V - V_clean, axis=1) ** 2)) / d}
+    N = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    N0 = np.cross(V_clean[F[:, 1]] - V_clean[F[:, 0]], V_clean[F[:, 2]] - V_clean[F[:, 0]])
+    sine = np.linalg.norm(np.cross(N, N0), axis=1)
+    out["normal_mean"] = np.rad2deg(np.arctan2(sine, np.einsum("ij,ij->i", N, N0))).mean()
+    vol = np.einsum("ij,ij->", V[F[:, 0]], N) / 6  # x0 . (x1 - x0) x (x2 - x0) = x0 . (x1 x x2)
+    vol0 = np.einsum("ij,ij->", V_clean[F[:, 0]], N0) / 6
+    out["volume_change"] = vol / vol0 - 1
+    return out
+
+
+@student("denoising_metrics", named="radians")
+def metrics_radians(V, V_clean, F):
     d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
-    return np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / d
+    cos = np.sum(_unit_normals(V, F) * _unit_normals(V_clean, F), axis=1)
+    vol = np.linalg.det(V[F]).sum() / 6
+    vol0 = np.linalg.det(V_clean[F]).sum() / 6
+    return {
+        "rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / d,
+        "normal_mean": np.mean(np.arccos(np.clip(cos, -1, 1))),
+        "volume_change": (vol - vol0) / abs(vol0),
+    }
 
 
-@student("vertex_rms", named="3n coordinates")
-def rms_coordinates(V, V_clean):
-    return np.sqrt(np.mean((V - V_clean) ** 2)) / _diag(V_clean)
+@student("denoising_metrics", named="NaN")
+def metrics_unclipped(V, V_clean, F):
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    theta = np.degrees(np.arccos(np.einsum("ij,ij->i", _unit_normals(V, F), _unit_normals(V_clean, F))))
+    vol = np.linalg.det(V[F]).sum() / 6
+    vol0 = np.linalg.det(V_clean[F]).sum() / 6
+    rms = np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / d
+    return {"rms": rms, "normal_mean": theta.mean(), "volume_change": (vol - vol0) / abs(vol0)}
 
 
-@student("vertex_rms", named="noisy mesh's diagonal")
-def rms_noisy_diagonal(V, V_clean):
-    dist = np.linalg.norm(V - V_clean, axis=1)
-    return np.sqrt((dist**2).mean()) / _diag(V)
+@student("denoising_metrics", named="not of unit length")
+def metrics_raw_normals(V, V_clean, F):
+    e2 = ((V - V_clean) ** 2).sum(axis=1)
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    a, b, c = (V[F[:, k]] for k in range(3))
+    a0, b0, c0 = (V_clean[F[:, k]] for k in range(3))
+    dots = (np.cross(b - a, c - a) * np.cross(b0 - a0, c0 - a0)).sum(axis=1)
+    vol, vol0 = (a * np.cross(b, c)).sum() / 6, (a0 * np.cross(b0, c0)).sum() / 6
+    return {
+        "rms": np.sqrt(e2.mean()) / d,
+        "normal_mean": np.degrees(np.arccos(np.clip(dots, -1, 1))).mean(),
+        "volume_change": (vol - vol0) / abs(vol0),
+    }
+
+
+@student("denoising_metrics", named="volume change is absolute")
+def metrics_absolute_volume(V, V_clean, F):
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
+    vol = lambda X: np.sum(X[F[:, 0]] * np.cross(X[F[:, 1]], X[F[:, 2]])) / 6  # noqa: E731
+    return {
+        "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
+        "normal_mean": np.degrees(np.arccos(cos)).mean(),
+        "volume_change": vol(V) - vol(V_clean),
+    }
+
+
+@student("denoising_metrics", named="noisy mesh's diagonal")
+def metrics_noisy_diagonal(V, V_clean, F):
+    d = np.linalg.norm(V.max(axis=0) - V.min(axis=0))  # the mesh being measured
+    cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
+    vol = np.linalg.det(V[F]).sum() / 6
+    vol0 = np.linalg.det(V_clean[F]).sum() / 6
+    return {
+        "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
+        "normal_mean": np.degrees(np.arccos(cos)).mean(),
+        "volume_change": (vol - vol0) / abs(vol0),
+    }
+
+
+@student("denoising_metrics", named="unsigned")
+def metrics_unsigned_volume(V, V_clean, F):
+    d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
+    vol = np.abs(np.linalg.det(V[F])).sum() / 6  # a volume is positive
+    vol0 = np.abs(np.linalg.det(V_clean[F])).sum() / 6
+    return {
+        "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
+        "normal_mean": np.degrees(np.arccos(cos)).mean(),
+        "volume_change": (vol - vol0) / vol0,
+    }
 
 
 # ============================================================================ 07 · denoising_experiment
@@ -1223,6 +1495,110 @@ def sweep_explicit(W, F, V_clean, taus, iterations):
     E = np.array(E)
     i, k = np.unravel_index(E.argmin(), E.shape)
     return taus[i], k, E
+
+
+# ============================================================================ 07 · taubin_smoothing
+
+
+@student("taubin_smoothing")
+def taubin_rows(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, weights="uniform")
+    inner = np.setdiff1d(np.arange(len(V)), boundary_vertices(F, len(V)))
+    L = (sp.diags(1 / M.diagonal()) @ C).tocsr()[inner]  # the rows that move
+    P = V.copy()
+    for _ in range(pairs):
+        for tau in (tau_shrink, tau_inflate):
+            P[inner] = P[inner] + tau * (L @ P)
+    return P
+
+
+@student("taubin_smoothing")
+def taubin_neighbour_average(V, F, tau_shrink, tau_inflate, pairs):
+    n = len(V)
+    edges = np.sort(np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    e, count = np.unique(edges, axis=0, return_counts=True)
+    A = sp.coo_matrix((np.ones(2 * len(e)), (np.r_[e[:, 0], e[:, 1]], np.r_[e[:, 1], e[:, 0]])), shape=(n, n)).tocsr()
+    valence = np.asarray(A.sum(axis=1)).ravel()
+    fixed = np.zeros(n, bool)
+    fixed[e[count == 1].ravel()] = True  # an edge of one face lies on the boundary
+    P = V.astype(float).copy()
+    for _ in range(pairs):
+        for t in (tau_shrink, tau_inflate):
+            umbrella = (A @ P) / valence[:, None] - P  # the mean of the neighbours minus the vertex
+            P = np.where(fixed[:, None], P, P + t * umbrella)
+    return P
+
+
+@student("taubin_smoothing", named="wrong sign")
+def taubin_minus_mu(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, "uniform")
+    free = np.ones(len(V), bool)
+    free[boundary_vertices(F, len(V))] = False
+    m = M.diagonal()[free, None]
+    P = V.copy()
+    for _ in range(pairs):
+        P[free] += tau_shrink * (C @ P)[free] / m
+        P[free] -= tau_inflate * (C @ P)[free] / m  # inflate: the other direction
+    return P
+
+
+@student("taubin_smoothing", named="counted instead of pairs")
+def taubin_alternating_steps(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, "uniform")
+    b = boundary_vertices(F, len(V))
+    P = V.copy()
+    for k in range(pairs):
+        tau = tau_shrink if k % 2 == 0 else tau_inflate
+        step = tau * (C @ P) / M.diagonal()[:, None]
+        step[b] = 0
+        P = P + step
+    return P
+
+
+@student("taubin_smoothing", named="boundary vertices moved")
+def taubin_free_boundary(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, weights="uniform")
+    Minv = sp.diags(1.0 / M.diagonal())
+    P = V.copy()
+    for _ in range(pairs):
+        P = P + tau_shrink * (Minv @ (C @ P))
+        P = P + tau_inflate * (Minv @ (C @ P))
+    return P
+
+
+@student("taubin_smoothing", named="M^-1 is missing")
+def taubin_no_mass(V, F, tau_shrink, tau_inflate, pairs):
+    _, C = laplacian(V, F, "uniform")
+    keep = boundary_vertices(F, len(V))
+    P = V.copy()
+    for _ in range(2 * pairs):
+        tau = tau_inflate if _ % 2 else tau_shrink
+        Q = P + tau * (C @ P)
+        Q[keep] = V[keep]
+        P = Q
+    return P
+
+
+@student("taubin_smoothing", named="same P")
+def taubin_simultaneous(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F, "uniform")
+    inner = np.setdiff1d(np.arange(len(V)), boundary_vertices(F, len(V)))
+    P = V.copy()
+    for _ in range(pairs):
+        lap = (C @ P) / M.diagonal()[:, None]
+        P[inner] += tau_shrink * lap[inner] + tau_inflate * lap[inner]  # both from this P
+    return P
+
+
+@student("taubin_smoothing", named="cotangent weights")
+def taubin_cotan(V, F, tau_shrink, tau_inflate, pairs):
+    M, C = laplacian(V, F)  # the default weights
+    inner = np.setdiff1d(np.arange(len(V)), boundary_vertices(F, len(V)))
+    P = V.copy()
+    for _ in range(pairs):
+        P[inner] += tau_shrink * (C @ P)[inner] / M.diagonal()[inner, None]
+        P[inner] += tau_inflate * (C @ P)[inner] / M.diagonal()[inner, None]
+    return P
 
 
 # ============================================================================ a second batch, written before the
@@ -1360,25 +1736,6 @@ def eigen_unit_columns(M, C, k):
     return lam, E / np.linalg.norm(E, axis=0)
 
 
-@student("spectral_reconstruction", named="the uniform operator")
-def reconstruct_uniform(V, F, k):
-    n = len(V)
-    A = np.zeros((n, n))
-    for i, j, l in F:
-        A[i, j] = A[j, i] = A[j, l] = A[l, j] = A[i, l] = A[l, i] = 1
-    deg = A.sum(axis=1)
-    lam, E = sla.eigh(np.diag(deg) - A, np.diag(deg))
-    Ek = E[:, :k]
-    return Ek @ (Ek.T @ (deg[:, None] * V))
-
-
-@student("spectral_reconstruction", named="one eigenvector too many")
-def reconstruct_k_plus_one(V, F, k):
-    M, C = laplacian(V, F)
-    lam, E = sla.eigh(-C.toarray(), M.toarray(), subset_by_index=[0, k])
-    return E @ E.T @ M @ V
-
-
 @student("lam_max")
 def lam_max_power_on_laplacian(M, C):
     # power iteration on -M^-1 C itself: not symmetric, but its eigenvalues are those of Q
@@ -1490,14 +1847,28 @@ def noise_unscaled(V, F, sigma, seed):
     return V + np.random.default_rng(seed).normal(scale=sigma, size=V.shape)
 
 
-@student("vertex_rms", named="not rooted")
-def rms_unrooted(V, V_clean):
-    return np.mean(np.sum((V - V_clean) ** 2, axis=1)) / _diag(V_clean) ** 2
+@student("denoising_metrics", named="not rooted")
+def metrics_unrooted(V, V_clean, F):
+    diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    n, n0 = _unit_normals(V, F), _unit_normals(V_clean, F)
+    vols = [np.einsum("ij,ij->", X[F[:, 0]], np.cross(X[F[:, 1]], X[F[:, 2]])) / 6 for X in (V, V_clean)]
+    return {
+        "rms": np.mean(np.sum((V - V_clean) ** 2, axis=1)) / diag**2,
+        "normal_mean": np.rad2deg(np.arccos(np.clip(np.sum(n * n0, axis=1), -1, 1))).mean(),
+        "volume_change": (vols[0] - vols[1]) / abs(vols[1]),
+    }
 
 
-@student("vertex_rms", named="mean of the distances")
-def rms_mean_distance(V, V_clean):
-    return np.linalg.norm(V - V_clean, axis=1).mean() / _diag(V_clean)
+@student("denoising_metrics", named="divided by the new volume")
+def metrics_over_new_volume(V, V_clean, F):
+    diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    n, n0 = _unit_normals(V, F), _unit_normals(V_clean, F)
+    vol, vol0 = (np.linalg.det(X[F]).sum() / 6 for X in (V, V_clean))
+    return {
+        "rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / diag,
+        "normal_mean": np.rad2deg(np.arccos(np.clip(np.sum(n * n0, axis=1), -1, 1))).mean(),
+        "volume_change": (vol - vol0) / vol,
+    }
 
 
 @student("denoising_experiment", named="the error is absolute")

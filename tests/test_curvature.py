@@ -9,7 +9,9 @@ from meshdata import COURSE, COURSE_MESHES, SHIPPED, load_quietly, needs_course
 from geomlib import (
     MeshError,
     MeshWarning,
+    discrete_principal_curvatures,
     gaussian_curvature,
+    laplacian,
     mean_curvature,
     principal_curvatures,
     surfaces,
@@ -104,6 +106,101 @@ def test_principal_curvatures_identities_and_sphere():
     k1, k2 = principal_curvatures(np.full(3, 2.0), np.array([4.0, 4.1, 3.0]))
     np.testing.assert_allclose(k1, [2.0, 2.0, 3.0])
     np.testing.assert_allclose(k2, [2.0, 2.0, 1.0])
+
+
+def kappas(V, F, area="mixed"):
+    """discrete_principal_curvatures of the cotangent pair of ``area`` and the boundary-NaN deficit."""
+    M, C = laplacian(V, F, area=area)
+    return discrete_principal_curvatures(V, F, M, C, gaussian_curvature(V, F, integrated=True))
+
+
+@pytest.mark.parametrize("r", [0.5, 3.0])
+def test_discrete_principal_curvatures_of_a_sphere_are_one_over_r(r):
+    s = surfaces.sphere(r, subdivisions=4)
+    k1, k2 = kappas(s.V, s.F)
+    assert np.abs(k1 * r - 1).max() < 0.02 and np.abs(k2 * r - 1).max() < 0.02
+    coarse = surfaces.sphere(r, subdivisions=2)  # twice the edge length: the error is larger
+    assert np.abs(kappas(coarse.V, coarse.F)[0] * r - 1).max() > np.abs(k1 * r - 1).max()
+
+
+@pytest.mark.parametrize("jitter", [0.0, 0.3])
+def test_discrete_principal_curvatures_of_a_plane_are_zero_inside_and_nan_on_the_boundary(jitter):
+    p = surfaces.plane(n=9, size=2.0, jitter=jitter, seed=4)
+    k1, k2 = kappas(p.V, p.F)
+    boundary = boundary_mask(p.V, p.F)
+    assert np.isnan(k1[boundary]).all() and np.isnan(k2[boundary]).all()
+    # H and K are 0 to rounding (1e-14); the square root of H^2 - K lifts that to about 1e-7 on edges of 0.25
+    assert np.abs(k1[~boundary]).max() < 1e-6 and np.abs(k2[~boundary]).max() < 1e-6
+    # the rule holds whatever the deficit holds at the boundary (here the interior formula, pi there)
+    M, C = laplacian(p.V, p.F, area="mixed")
+    deficit = 2 * np.pi - angle_sums(p.V, p.F)
+    assert np.isnan(discrete_principal_curvatures(p.V, p.F, M, C, deficit)[0][boundary]).all()
+
+
+@pytest.mark.parametrize("jitter", [0.0, 0.3])
+def test_discrete_principal_curvatures_are_ordered_and_give_back_h_and_k(jitter):
+    e = surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=3, jitter=jitter, seed=2)
+    M, C = laplacian(e.V, e.F, area="mixed")
+    deficit = gaussian_curvature(e.V, e.F, integrated=True)
+    k1, k2 = discrete_principal_curvatures(e.V, e.F, M, C, deficit)
+    H = mean_curvature(e.V, e.F, area="mixed", signed=True)
+    K = deficit / M.diagonal()
+    assert (k1 >= k2).all()
+    np.testing.assert_allclose(k1 + k2, 2 * H, rtol=1e-12)
+    real = H * H >= K  # where the root exists, k1 k2 = K exactly; elsewhere the clamp gives k1 = k2 = H
+    assert real.any() and (~real).any()
+    np.testing.assert_allclose((k1 * k2)[real], K[real], rtol=1e-9)
+    assert np.array_equal(k1[~real], H[~real]) and np.array_equal(k2[~real], H[~real])
+    within = 0.05 if jitter == 0 else 0.1  # the jittered mesh converges only weakly (notebook 03)
+    assert np.median(np.abs(k1 - e.k1) / e.k1) < within and np.median(np.abs(k2 - e.k2) / e.k2) < within
+
+
+def test_discrete_principal_curvatures_scale_as_one_over_length_and_flip_with_the_orientation():
+    e = surfaces.ellipsoid(1.0, 0.7, 0.5, subdivisions=2)
+    k1, k2 = kappas(e.V, e.F)
+    s1, s2 = kappas(2.5 * e.V, e.F)
+    np.testing.assert_allclose(s1, k1 / 2.5, rtol=1e-12)
+    np.testing.assert_allclose(s2, k2 / 2.5, rtol=1e-12)
+    f1, f2 = kappas(e.V, e.F[:, ::-1])  # inward normals: H changes sign, K does not: (-k2, -k1)
+    np.testing.assert_allclose(f1, -k2, rtol=1e-12)
+    np.testing.assert_allclose(f2, -k1, rtol=1e-12)
+
+
+def test_discrete_principal_curvatures_of_a_saddle_have_opposite_signs():
+    s = surfaces.saddle(n=20)
+    k1, k2 = kappas(s.V, s.F)
+    inside = ~boundary_mask(s.V, s.F) & (s.K < -0.05 * np.abs(s.K).max())
+    assert inside.any() and (k1[inside] > 0).all() and (k2[inside] < 0).all()
+
+
+def test_discrete_principal_curvatures_are_nan_at_a_vertex_of_no_area_without_a_warning():
+    import scipy.sparse as sp
+
+    s = surfaces.sphere(1.0, subdivisions=1)
+    M, C = laplacian(s.V, s.F)
+    V = np.vstack([s.V, [[5.0, 5.0, 5.0]]])  # in no triangle: M_ii = 0
+    M, C = sp.block_diag([M, sp.csr_matrix((1, 1))]), sp.block_diag([C, sp.csr_matrix((1, 1))])
+    deficit = np.append(gaussian_curvature(s.V, s.F, integrated=True), 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        k1, k2 = discrete_principal_curvatures(V, s.F, M, C, deficit)
+    assert np.isnan(k1[-1]) and np.isnan(k2[-1]) and np.isfinite(k1[:-1]).all()
+
+
+def test_discrete_principal_curvatures_refuse_bad_input():
+    s = surfaces.sphere(1.0, subdivisions=1)
+    M, C = laplacian(s.V, s.F)
+    deficit = gaussian_curvature(s.V, s.F, integrated=True)
+    with pytest.raises(MeshError, match=r"M has shape \(41, 41\), expected \(42, 42\)"):
+        discrete_principal_curvatures(s.V, s.F, M.tocsr()[:41, :41], C, deficit)
+    with pytest.raises(MeshError, match=r"C has shape None"):
+        discrete_principal_curvatures(s.V, s.F, M, "C", deficit)
+    with pytest.raises(MeshError, match=r"deficit has shape \(41,\), expected \(42,\)"):
+        discrete_principal_curvatures(s.V, s.F, M, C, deficit[:41])
+    with pytest.raises(MeshError, match=r"negative vertex areas at vertices 0"):
+        discrete_principal_curvatures(s.V, s.F, -M, C, deficit)
+    with pytest.raises(MeshError):
+        discrete_principal_curvatures(s.V[:, :2], s.F, M, C, deficit)
 
 
 # ---------------------------------------------------------------- Gauss-Bonnet

@@ -10,6 +10,7 @@ import trimesh
 from meshdata import COURSE
 
 from geomlib import MeshError, MeshWarning, explicit_smoothing, explicit_step_limit, implicit_smoothing, laplacian
+from geomlib.lessons.filters import mode_factor
 from geomlib.lessons.smoothing import (
     ExplicitSmoother,
     ImplicitSmoother,
@@ -17,6 +18,7 @@ from geomlib.lessons.smoothing import (
     fixed_point,
     highest_frequency_mode,
     implicit_step,
+    taubin_smoothing,
     volume_rescaled,
 )
 from geomlib.mesh.geometry import volume_and_centroid
@@ -746,3 +748,81 @@ def test_volume_rescaled_gives_back_the_volume_and_centroid_of_the_reference():
     assert abs(vol / vol0 - 1) < 1e-12 and np.allclose(c, c0, atol=1e-12)
     with pytest.raises(MeshError, match="enclosed volume became"):
         volume_rescaled(np.zeros_like(V), F, V)
+
+
+# ---------------------------------------------------------------- Taubin's filter (Taubin 1995)
+
+
+def test_one_taubin_pair_multiplies_an_eigenvector_by_the_pair_s_factor_exactly():
+    from scipy.linalg import eigh
+
+    V, F = icosphere(1)  # closed, valences 5 and 6: the uniform operator depends on F alone
+    M, C = laplacian(V, F, "uniform")
+    lam, E = eigh(-C.toarray(), M.toarray())  # C e = -lam M e
+    pick = [3, 12, 40]  # a low, a middle and a high mode as the three coordinates
+    tau_shrink, tau_inflate = 0.33, -0.34
+    for pairs in (1, 3):
+        P = taubin_smoothing(E[:, pick], F, tau_shrink, tau_inflate, pairs)
+        factor = ((1 - tau_shrink * lam[pick]) * (1 - tau_inflate * lam[pick])) ** pairs
+        np.testing.assert_allclose(P, E[:, pick] * factor, atol=1e-12)
+        np.testing.assert_allclose(factor[0] ** (1 / pairs), mode_factor(lam[3], tau_shrink, "taubin", tau_inflate))
+
+
+def test_taubin_holds_the_boundary_and_keeps_the_valence_weighted_centroid():
+    V, F = grid(9, jitter=0.3)
+    V[:, 2] = 0.1 * np.random.default_rng(2).standard_normal(len(V))
+    P = taubin_smoothing(V, F, 0.5, -0.53, 7)
+    held = _boundary_mask(F, len(V))
+    assert np.array_equal(P[held], V[held]) and not np.allclose(P[~held], V[~held])
+    W, G = icosphere(2, centre=(1.0, -2.0, 0.5))
+    W = W + 0.02 * np.random.default_rng(3).standard_normal(W.shape)
+    m = laplacian(W, G, "uniform")[0].diagonal()  # the valences: 1^T C = 0, so sum_i m_i p_i is kept
+    Q = taubin_smoothing(W, G, 0.5, -0.53, 20)
+    np.testing.assert_allclose(m @ Q / m.sum(), m @ W / m.sum(), atol=1e-12)
+    assert not np.allclose(Q.mean(axis=0), W.mean(axis=0), atol=1e-9, rtol=0)  # the plain mean moves: valences differ
+
+
+def test_taubin_steps_are_explicit_steps_and_match_trimesh():
+    V, F = icosphere(2)
+    W = V + 0.01 * np.random.default_rng(4).standard_normal(V.shape)
+    M, C = laplacian(W, F, "uniform")
+    seen = []
+    P = taubin_smoothing(W, F, 0.5, -0.5, 3, callback=lambda k, P: seen.append(k))
+    Q = W
+    for _ in range(3):
+        Q = explicit_step(explicit_step(Q, M, C, 0.5), M, C, -0.5)
+    mesh = trimesh.smoothing.filter_taubin(trimesh.Trimesh(W.copy(), F, process=False), lamb=0.5, nu=0.5, iterations=6)
+    np.testing.assert_allclose(P, Q, atol=1e-13)
+    np.testing.assert_allclose(P, mesh.vertices, atol=1e-12)
+    assert seen == [1, 2, 3] and np.array_equal(taubin_smoothing(W, F, 0.5, -0.5, 0), W)
+
+
+def test_taubin_past_its_limit_diverges_clearly():
+    V, F = icosphere(1)
+    W = V + 0.01 * np.random.default_rng(5).standard_normal(V.shape)
+    with pytest.raises(MeshError, match="diverged at pair") as caught:
+        taubin_smoothing(W, F, 1.9, -1.9, 200)  # |1 - 1.9^2 lam^2| > 1 for the top modes
+    assert np.isfinite(caught.value.V).all()
+    with pytest.warns(MeshWarning, match="diverged"):
+        assert np.isfinite(taubin_smoothing(W, F, 1.9, -1.9, 200, on_failure="stop")).all()
+
+
+@pytest.mark.parametrize(
+    "args, match",
+    [
+        ((0.0, -0.5, 1), "tau_shrink > 0 > tau_inflate"),
+        ((0.5, 0.5, 1), "tau_shrink > 0 > tau_inflate"),
+        ((-0.5, 0.53, 1), "tau_shrink > 0 > tau_inflate"),
+        ((0.5, -0.53, -1), "pairs"),
+        ((0.5, -0.53, 1.5), "pairs"),
+        ((0.5, float("nan"), 1), "tau_inflate"),
+    ],
+)
+def test_taubin_refuses_bad_input(args, match):
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match=match):
+        taubin_smoothing(V, F, *args)
+    with pytest.raises(MeshError, match="weights"):
+        taubin_smoothing(V, F, 0.5, -0.53, 1, weights="umbrella")
+    with pytest.raises(MeshError):
+        taubin_smoothing(V[:, :2], F, 0.5, -0.53, 1)

@@ -21,6 +21,7 @@ from geomlib import (
     spectral_cache_dir,
     spectral_reconstruction,
 )
+from geomlib.lessons.spectral import spectral_reconstructions
 from geomlib.teaching.shapes.surfaces import ellipsoid, icosphere, sphere
 
 
@@ -224,6 +225,43 @@ def test_residual_norms_follow_parseval(egg):
     for k in (1, 7, 30):
         direct = np.sqrt(np.sum(m[:, None] * (V - basis.reconstruct(V, k)) ** 2))
         assert norms[k - 1] == pytest.approx(direct, rel=1e-7, abs=1e-10)
+
+
+def test_reconstructions_from_one_solve_are_the_projections_and_their_errors_parsevals(egg):
+    """spectral_reconstructions: one solve of max(ks) pairs, V_k in the order of ks, the error measured directly."""
+    V, F = egg
+    m, _ = _mass(V, F)
+    asked = []
+
+    def solve(M, C, k):
+        asked.append(k)
+        return geomlib.lessons.spectral.eigenpairs(M, C, k)
+
+    ks = [12, 1, 30, 7]
+    V_ks, err = spectral_reconstructions(V, F, ks, solve)
+    assert asked == [30] and V_ks.shape == (4, len(V), 3) and err.shape == (4,)
+    basis = spectral_basis(V, F, 30, cache=False)
+    scale = np.sqrt(m.sum()) * geomlib.bounding_box_diagonal(V)
+    for V_k, e, k in zip(V_ks, err, ks):
+        np.testing.assert_allclose(V_k, basis.reconstruct(V, k), atol=1e-12 * np.abs(V).max())
+        assert e == pytest.approx(basis.residual_norms(V)[k - 1] / scale, rel=1e-7)
+    # k = 1 keeps the area-weighted centroid: the error is the RMS distance to it
+    centroid = m @ V / m.sum()
+    assert err[1] == pytest.approx(np.sqrt(m @ np.sum((V - centroid) ** 2, axis=1)) / scale)
+
+
+def test_reconstruction_errors_are_scale_free_and_vanish_at_k_equal_n():
+    P, F = icosphere(1)
+    V = P * [1.0, 0.8, 0.6]
+    V_ks, err = spectral_reconstructions(V, F, [3, len(V)])
+    np.testing.assert_allclose(V_ks[1], V, atol=1e-12)
+    assert err[1] < 1e-12 and 0 < err[0] < 1
+    moved = spectral_reconstructions(7.0 * V + [1.0, -2.0, 3.0], F, [3, len(V)])[1]  # err: no unit, no origin
+    np.testing.assert_allclose(moved, err, rtol=1e-9, atol=1e-12)
+    with pytest.raises(MeshError, match="ks is empty"):
+        spectral_reconstructions(V, F, [])
+    with pytest.raises(MeshError, match="at most n = 42"):
+        spectral_reconstructions(V, F, [5, 43])
 
 
 # --------------------------------------------------------------------------

@@ -129,3 +129,19 @@ def test_notebook_07_compares_at_the_assignment_s_noise_level():
             values[node.targets[0].id] = ast.literal_eval(node.value)
     assert values["DENOISE_SIGMA"] == 0.05 and values["DENOISE_ITERATIONS"] == 200 and values["DENOISE_STEP"] == 1e-3
     assert values["DENOISE_SIGMA"] in values["SIGMAS"]
+
+
+def test_the_comparison_s_taubin_pairs_are_geomlib_s_taubin_smoothing(monkeypatch):
+    import geomlib.lessons.smoothing as smoothing
+
+    V, F = icosphere(1)
+    grids = {("taubin", "uniform"): ((0.3,), (2,))}
+    R = denoising_comparison(V, F, (0.01,), 3, grids=grids, workers=1)
+    W = geomlib.add_noise(V, F, 0.01, 3)
+    tau = 0.3 * geomlib.explicit_step_limit(W, F, "uniform")
+    P = geomlib.taubin_smoothing(W, F, tau, -tau, 2)
+    assert R.values["rms"][0][0, 0, 0] == pytest.approx(geomlib.vertex_rms(P, V), rel=1e-12)
+    shown = smoothing.explicit_step
+    monkeypatch.setattr(smoothing, "explicit_step", lambda P, M, C, tau: shown(P, M, C, tau) + [1.0, 0, 0])
+    moved = denoising_comparison(V, F, (0.01,), 3, grids=grids, workers=1)
+    assert moved.values["rms"][0][0, 0, 0] > R.values["rms"][0][0, 0, 0] + 0.5  # 4 steps, each moved by 1

@@ -17,6 +17,8 @@ Boundary rules, in one place (each function's docstring repeats its own):
   values sum to ``2 pi chi`` exactly (Gauss-Bonnet with the boundary term);
   ``"deficit"``: the interior formula applied anyway (what a naive
   implementation reports, about ``pi / A`` too large on a flat boundary).
+* ``discrete_principal_curvatures``: NaN at boundary vertices, where neither the
+  signed H nor the deficit is a curvature.
 
 A boundary vertex is a vertex of an edge that belongs to exactly one triangle.
 
@@ -57,6 +59,7 @@ __all__ = [
     "signed_mean_curvature",
     "gaussian_curvature",
     "principal_curvatures",
+    "discrete_principal_curvatures",
     "angle_deficit",
     "angle_sums",
     "corner_angles",
@@ -311,3 +314,48 @@ def principal_curvatures(H, K):
     with np.errstate(invalid="ignore"):
         root = np.sqrt(np.maximum(H * H - K, 0.0))
     return H + root, H - root
+
+
+def discrete_principal_curvatures(V, F, M, C, deficit):
+    """Principal curvatures ``kappa_1 >= kappa_2`` per vertex, each (n,) float64 in 1/length, from (M, C) and K.
+
+    Meyer et al. 2003, section 5: on a smooth surface ``H = (kappa_1 + kappa_2) / 2`` and
+    ``K = kappa_1 kappa_2``, so the two are the roots of ``kappa^2 - 2 H kappa + K = 0``,
+    ``kappa_1,2 = H +- sqrt(H^2 - K)``. Here H is the signed mean curvature of the pair,
+    ``H_i = -1/2 <(M^-1 C x)_i, n_i>`` (:func:`signed_mean_curvature`: ``Delta x = -2 H n``, n the
+    area-weighted outward normal, so H > 0 and both kappas > 0 on a sphere), and K the pointwise
+    angle deficit ``K_i = deficit_i / M_ii``. Where the discrete ``H^2 - K`` is negative (near
+    umbilics) it is clamped to 0 (:func:`principal_curvatures`).
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64, counter-clockwise seen from outside.
+    M, C : (n, n) matrices of :func:`geomlib.laplacian` (M diagonal: the vertex areas, length^2).
+    deficit : (n,) float64
+        The integrated Gaussian curvature ``2 pi - sum of the angles at i`` in radians
+        (:func:`angle_deficit`, or ``gaussian_curvature(V, F, integrated=True)``).
+
+    Returns
+    -------
+    (kappa_1, kappa_2) : each (n,) float64, pointwise, ``kappa_1 >= kappa_2``.
+        NaN at boundary vertices (the one-ring is open: neither H nor the deficit is a curvature
+        there, whatever ``deficit`` holds), and where ``M_ii = 0`` or the deficit is NaN.
+    """
+    V, F = as_mesh(V, F)
+    n = len(V)
+    for name, X in (("M", M), ("C", C)):
+        if getattr(X, "shape", None) != (n, n):
+            raise MeshError(
+                f"{name} has shape {getattr(X, 'shape', None)}, expected ({n}, {n}) for a mesh of {n} vertices"
+            )
+    deficit = np.asarray(deficit, dtype=float)
+    if deficit.shape != (n,):
+        raise MeshError(f"deficit has shape {deficit.shape}, expected ({n},): one angle deficit per vertex")
+    A = np.asarray(M.diagonal(), dtype=float)
+    if (A < 0).any():
+        raise MeshError(f"M has negative vertex areas at vertices {format_indices(np.flatnonzero(A < 0))}")
+    H = signed_mean_curvature(V, F, M, C)  # NaN on the boundary and where M_ii = 0
+    with np.errstate(divide="ignore", invalid="ignore"):  # where M_ii = 0, H is NaN and so are the kappas
+        K = deficit / A  # pointwise: the deficit per unit area
+    return principal_curvatures(H, K)

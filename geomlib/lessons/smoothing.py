@@ -10,10 +10,12 @@ moves a vertex against its outward normal where the surface is convex.
 * Implicit (backward Euler):  ``(M - tau C) P' = M P`` (:func:`implicit_step`),
   a sparse symmetric positive definite system (Desbrun, Meyer, Schroeder and
   Barr 1999), solved by a Cholesky factorisation (:mod:`geomlib.numerics.factor`).
+* Taubin's filter (Taubin 1995): pairs of explicit steps, a shrinking ``tau_shrink > 0``
+  then an inflating ``tau_inflate < 0`` (:func:`taubin_smoothing`).
 
 Every engine here (:func:`explicit_smoothing`, :func:`implicit_smoothing`,
-:class:`ExplicitSmoother`, :class:`ImplicitSmoother`, and through them the sweep
-of notebook 07) advances by calling these two functions, with the operator of
+:class:`ExplicitSmoother`, :class:`ImplicitSmoother`, :func:`taubin_smoothing`, and through
+them the sweeps of notebook 07) advances by calling these two functions, with the operator of
 :func:`geomlib.lessons.operator.laplace_operator` built once per mesh and options.
 
 Units of the step ``tau``: for the cotangent operator ``Delta`` has units
@@ -61,6 +63,7 @@ __all__ = [
     "volume_rescaled",
     "ExplicitSmoother",
     "ImplicitSmoother",
+    "taubin_smoothing",
 ]
 
 #: Explicit smoothing stops (see ``on_failure``) when a coordinate moves further
@@ -394,6 +397,48 @@ class ExplicitSmoother:
                     stacklevel=4,
                 )
         return tau
+
+
+# --------------------------------------------------------------------------
+# Taubin's filter
+
+
+def taubin_smoothing(V, F, tau_shrink, tau_inflate, pairs, weights="uniform", *, callback=None, on_failure="raise"):
+    """Taubin's lambda|mu filter: ``pairs`` times an explicit step of ``tau_shrink`` then one of ``tau_inflate``.
+
+    Each step is :func:`explicit_step`, ``P' = P + tau M^-1 C P``, with the operator of V built
+    once and kept (the uniform one, Taubin's, depends on F alone). In the eigenbasis of
+    ``-M^-1 C`` (``lam >= 0``) one pair multiplies the mode of ``lam`` by
+    ``(1 - tau_shrink lam)(1 - tau_inflate lam)``: near 1 for small ``lam`` (the shape is kept,
+    where explicit smoothing shrinks it) and below 1 in magnitude for the high modes, the noise
+    (Taubin, "A signal processing approach to fair surface design", SIGGRAPH 1995; his lambda
+    and mu are ``tau_shrink`` and ``tau_inflate``). The two steps commute: the order within a
+    pair does not matter. Boundary vertices are held where they are (``boundary_condition="fixed"``).
+
+    V (n, 3) float64 (not modified), F (m, 3) int64; ``tau_shrink > 0 > tau_inflate``, in the
+    operator's units (dimensionless for "uniform", length^2 for "cotan"); ``pairs >= 0``;
+    ``callback(k, P)`` after pair k; ``on_failure`` as in :func:`explicit_smoothing` (a run
+    whose coordinates leave ``BLOWUP_FACTOR`` bounding-box diagonals has diverged). Returns the
+    new (n, 3) positions. Raises MeshError for steps of the wrong signs, a bad count or option,
+    vertices with zero area, or a divergence with ``on_failure="raise"``.
+    """
+    if not real_number("tau_shrink", tau_shrink) > 0 > real_number("tau_inflate", tau_inflate):
+        raise MeshError(f"Taubin's pair needs tau_shrink > 0 > tau_inflate, not ({tau_shrink!r}, {tau_inflate!r})")
+    pairs = whole_number("pairs", pairs, 0)
+    check_choice("on_failure", on_failure, ON_FAILURE)
+    V, F, L = smoothing_operator(V, F, weights, "barycentric", "fixed")
+    L.require_positive_areas(F, "taubin_smoothing")
+    M, C = L.M_step, L.C_step  # the fixed vertices' rows of C are zero: they stay in place
+    far = BLOWUP_FACTOR * max(bounding_box_diagonal(V), np.finfo(float).tiny)
+    P = V.copy()
+    for k in range(1, pairs + 1):
+        P_next = explicit_step(explicit_step(P, M, C, tau_shrink), M, C, tau_inflate)  # shrink, then inflate
+        if not np.abs(P_next - V).max() <= far:  # NaN fails the comparison too
+            return _fail(on_failure, f"Taubin smoothing diverged at pair {k}", k, P)
+        P = P_next
+        if callback is not None:
+            callback(k, P)
+    return P
 
 
 # --------------------------------------------------------------------------

@@ -56,6 +56,7 @@ __all__ = [
     "ClaimFailed",
     "strict_claims",
     "graded",
+    "text_only",
     "NOTE_PREFIX",
 ]
 
@@ -78,6 +79,16 @@ def graded():
     """True while nbgrader runs the notebook (``nbgrader autograde`` and ``validate`` set
     ``NBGRADER_EXECUTION`` in the kernel): exercise checks then raise, views give stills."""
     return bool(os.environ.get("NBGRADER_EXECUTION"))
+
+
+def text_only():
+    """Whether views and figures are shown as their text alone (a view's one-line summary, a
+    figure's alt text), without a widget or a picture: while nbgrader runs the notebook
+    (:func:`graded`). Its feedback pages are static HTML, where a widget is an empty
+    placeholder, and no grade cell needs a picture; drawing the pictures was about a fifth of
+    the kernels' work in a grading run (benchmarks/README.md). A reader's run, nbval's and the
+    website's draw everything."""
+    return graded()
 
 
 def _display(bundle):
@@ -140,7 +151,8 @@ def show_figure(fig, alt):
     """Display ``fig`` (a matplotlib Figure) as a PNG with the alt text ``alt``, then close it.
 
     ``alt`` says what the figure shows and, for a data plot, what it finds, in a sentence
-    or two built from the numbers plotted (WCAG 2.1, 1.1.1 Non-text content).
+    or two built from the numbers plotted (WCAG 2.1, 1.1.1 Non-text content). While
+    nbgrader grades (:func:`text_only`) it shows the alt text alone: nothing is drawn.
     """
     import base64
     import io
@@ -151,6 +163,10 @@ def show_figure(fig, alt):
     alt = " ".join(str(alt).split())
     if not alt:
         raise ValueError("show_figure needs an alt text that says what the figure shows")
+    if text_only():
+        plt.close(fig)
+        display({"text/plain": f"Figure: {alt}"}, raw=True)
+        return
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", bbox_inches="tight")
     plt.close(fig)

@@ -1,30 +1,23 @@
-"""Checks of the exercises of notebook 07: the noise, the error, the experiment and the sweep.
+"""Checks of the exercises of notebook 07: the noise, the measures, the experiment and the sweep.
 
-``add_noise(fn)`` checks ``fn(V, F, sigma, seed) -> V'``: Gaussian noise with standard
-deviation ``s = sigma * d`` per coordinate, ``d`` the bounding-box diagonal of V, independent
-per vertex and coordinate, seeded, V untouched. Noise is random, so this check is statistical:
-it measures the noise on a regular grid of 2,400 vertices (7,200 numbers, the standard
-deviation then known to about 1 %) and accepts a standard deviation within 6 % of ``s``. The
-wrong scalings it names are far apart on purpose: on the grid d = 357.1, the mean edge length
-ell = 5.72, the length of the largest corner |max(V)| = 1,442 (the grid sits away from the
-origin) and 1 differ by large factors. Coordinates of a vertex that move together (one normal
-number shared by x, y and z) are told by their correlation, and float32 positions by their
-rounding.
+``add_noise(fn)``: ``fn(V, F, sigma, seed) -> V'``, Gaussian noise of standard deviation ``s = sigma * d`` per
+coordinate (d the bounding-box diagonal of V), independent, seeded, V untouched. Statistical: on a grid of 2,400
+vertices (d = 357.1, mean edge 5.72, largest corner |max(V)| = 1,442 and 1 far apart, so the wrong scalings it
+names are too) a standard deviation within 6 % of s passes; shared x, y, z are told by their correlation.
 
-``vertex_rms(fn)`` checks ``fn(V, V_clean) -> float``:
-``sqrt(mean_i |x_i - x_i^clean|^2) / d_clean`` on cases with exact answers.
+``denoising_metrics(fn)``: ``fn(V, V_clean, F) -> {"rms", "normal_mean", "volume_change"}``, geomlib's definitions
+(:mod:`geomlib.lessons.metrics`), each measure compared to 1e-6 of itself on two closed meshes.
 
-``denoising_experiment(fn)`` checks ``fn(V_clean, F, sigma, tau, iterations, seed) -> E``:
-seeded noise relative to d, ``iterations`` implicit cotangent steps of ``tau`` from the
-noisy mesh, and the vertex RMS error against the *clean* mesh over its d. Any correct noise
-draw is accepted (``rng.normal``, another order of the draws), so noisy runs are compared
-statistically: on the shipped sphere scaled to d = 139 (2,562 vertices) the error of a correct
-run varies by about 1 % from one noise pattern to another, and a value within 5 % of geomlib's
-passes. One run has no noise (sigma = 0): its error is the shrinkage alone and is compared
-exactly, which tells N iterations from N - 1 or N + 1.
+``denoising_experiment(fn)``: ``fn(V_clean, F, sigma, tau, iterations, seed) -> E``, noise, ``iterations`` implicit
+cotangent steps, E against the clean mesh. Any correct noise draw passes, so noisy runs on the shipped sphere
+(d = 139; E varies by about 1 % between draws) pass within 5 % of geomlib's; a run without noise (its E the
+shrinkage alone) is compared exactly and tells N iterations from N - 1 or N + 1.
 
-``denoising_sweep(fn)`` checks ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)``
-on two noisy icospheres, every entry of the table exactly.
+``denoising_sweep(fn)``: ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` on two noisy
+icospheres, every entry of the table exactly.
+
+``taubin_smoothing(fn)``: ``fn(V, F, tau_shrink, tau_inflate, pairs) -> P``, Taubin's pairs on the uniform operator
+with the boundary held, against :func:`geomlib.taubin_smoothing` on an open bump and a closed icosphere.
 """
 
 import functools
@@ -32,11 +25,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ...mesh.geometry import bounding_box_diagonal, mean_edge_length
-from .catalogue import Case, Wrong, answer, judge, number, run
-from .result import Mistake, call, exercise
+from ...lessons.metrics import face_normal_angles, vertex_rms, volume_change
+from ...lessons.smoothing import taubin_smoothing as taubin_pairs
+from ...mesh.geometry import bounding_box_diagonal, face_cross, face_volumes, mean_edge_length
+from .catalogue import Case, Wrong, answer, judge, named, number, positions, run
+from .meshes import bump_4x4, irregular_bipyramid, jittered_icosphere, placed
+from .result import Mistake, call, case_rng, exercise
 
-__all__ = ["add_noise", "vertex_rms", "denoising_experiment", "denoising_sweep"]
+__all__ = ["add_noise", "denoising_metrics", "denoising_experiment", "denoising_sweep", "taubin_smoothing"]
 
 
 def _grid(nx, ny, spacing, height):
@@ -148,55 +144,80 @@ def add_noise(fn):
     ]
 
 
-# ------------------------------------------------------------------ the error
-# a tetrahedron with one vertex moved by 3 (exact answer 1.5 / d), a lopsided displacement field, no change;
-# each away from the origin
-_TET = np.array([[0.0, 0, 0], [2, 0, 0], [0, 1, 0], [0, 0, 4]]) + np.array([7.0, -3.0, 11.0])
+# ------------------------------------------------------------------ the measures
+# away from the origin (placed), closed: an icosphere with one vertex pulled out (74 of its 80 faces keep their
+# normal: an unclipped arccos meets a dot a rounding error above 1), a bipyramid shrunk and made noisy
+_KEYS = ("rms", "normal_mean", "volume_change")
+_METRICS = named("lessons.metrics", "denoising_metrics vertex_rms face_normal_angles volume_change MeshComparison")
+_SWEEPS = named("teaching.experiments.sweep", "smoothing_sweep denoising_comparison")
 
 
-def _rms_cases():
-    moved = _TET.copy()
-    moved[1, 0] += 3.0  # also widens the noisy bounding box
-    grid = _grid(7, 5, 1.0, 2.0)[0] + np.array([-20.0, 4.0, 9.0])
-    bumped = grid + np.random.default_rng(5).standard_normal(grid.shape) * np.linspace(0.05, 1.5, len(grid))[:, None]
-    cases = [
-        Case(label, V=V, V_clean=W)
-        for label, V, W in (
-            ("a tetrahedron with one vertex moved by 3", moved, _TET),
-            ("a grid with displacements of very different sizes", bumped, grid),
-            ("a mesh compared with itself", grid.copy(), grid),
-        )
-    ]
-    return [c.but(e2=np.sum((c.V - c.V_clean) ** 2, axis=1), d=bounding_box_diagonal(c.V_clean), n=1) for c in cases]
+def _pulled(V, c, ell, rng):  # vertex 0 moved outwards: the volume grows
+    return V + np.where(np.arange(len(V))[:, None] == 0, 0.4 * ell * (V[0] - c) / np.linalg.norm(V[0] - c), 0.0)
+
+
+def _shrunk(V, c, ell, rng):
+    return c + 0.85 * (V - c) + rng.normal(scale=0.15 * ell, size=V.shape)
+
+
+def _measure_cases():
+    rng, cases = case_rng(), []
+    for label, mesh, move in (("an icosphere with one vertex pulled out", jittered_icosphere(), _pulled),
+                              ("a bipyramid shrunk and made noisy", irregular_bipyramid(), _shrunk)):  # fmt: skip
+        V_clean, F = placed(*mesh, rng)
+        V = move(V_clean, V_clean.mean(axis=0), mean_edge_length(V_clean, F), rng)
+        (N, t), (N_clean, t_clean) = ((face_cross(X, F), face_volumes(X, F)) for X in (V, V_clean))
+        theta = face_normal_angles(V, V_clean, F)
+        right = np.array([vertex_rms(V, V_clean), theta.mean(), volume_change(V, V_clean, F)])
+        cases.append(Case(label, V=V, V_clean=V_clean, F=F).but(
+            right=right, scale=np.abs(right), e2=np.sum((V - V_clean) ** 2, axis=1), d=bounding_box_diagonal(V_clean),
+            d_noisy=bounding_box_diagonal(V), theta=theta, A_clean=np.linalg.norm(N_clean, axis=1) / 2, n=1,
+            raw=np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", N, N_clean), -1, 1))), vol=t.sum(),
+            vol_clean=t_clean.sum(), unsigned=np.abs(t).sum(), unsigned_clean=np.abs(t_clean).sum()))  # fmt: skip
+    return cases
+
+
+def _part(i, diagnosis, hint, value):
+    """A wrong answer: the right measures with measure ``i`` replaced by ``value(case)``."""
+    return Wrong(diagnosis, hint, build=lambda c: np.where(np.arange(3) == i, value(c), c.right) / c.scale)
+
+
+def _measures(out, c):
+    if not isinstance(out, dict) or not set(_KEYS) <= set(out):
+        raise Mistake('the function did not return a dict with the keys "rms", "normal_mean" and "volume_change"',
+                      'end with return {"rms": E, "normal_mean": ..., "volume_change": ...}', typical=False)  # fmt: skip
+    return np.array([number(out[key], f'"{key}"') for key in _KEYS]) / c.scale
 
 
 # fmt: off
-RMS_MISTAKES = [
-    _scalar('the result is negative', 'a root mean square is >= 0', lambda c: -np.sqrt(c.e2.mean()) / c.d),
-    _scalar('the result is not relative: it is in length units, not divided by the bounding-box diagonal', 'divide by d, the bounding-box diagonal of the clean mesh', lambda c: np.sqrt(c.e2.mean())),
-    _scalar('this is the mean of the distances, not the root of the mean square', 'square each distance, average, then take the square root', lambda c: np.sqrt(c.e2).mean() / c.d),
-    _scalar('the mean squared error is not rooted', 'take the square root of the mean of |x_i - x_i^clean|^2', lambda c: c.e2.mean() / c.d),
-    _scalar('the mean squared error is not rooted (this is RMS^2)', 'take the square root of the mean before comparing', lambda c: c.e2.mean() / c.d ** 2),
-    _scalar('the squared distances are summed, not averaged', 'divide the sum by the number of vertices n before the square root', lambda c: np.sqrt(c.e2.sum()) / c.d),
-    _scalar('the distances are summed, not averaged (and not squared)', 'RMS = sqrt(mean_i |x_i - x_i^clean|^2)', lambda c: np.sqrt(c.e2).sum() / c.d),
-    _scalar('the mean runs over the 3n coordinates instead of the n vertices', "square the length of each vertex's displacement, then average over vertices", lambda c: np.sqrt(c.e2.mean() / 3) / c.d),
-    _scalar("divided by the noisy mesh's diagonal instead of the clean one", 'd is the bounding-box diagonal of V_clean, the truth we measure against', lambda c: np.sqrt(c.e2.mean()) / bounding_box_diagonal(c.V)),
-    Wrong('the result differs from sqrt(mean_i |x_i - x_i^clean|^2) / d on {label}', "d is the clean mesh's bounding-box diagonal", typical=False),
+MEASURE_MISTAKES = [
+    _part(0, "E is not relative: it is in length units, not divided by the bounding-box diagonal", 'divide by d, the bounding-box diagonal of the clean mesh', lambda c: np.sqrt(c.e2.mean())),
+    _part(0, "E is divided by the noisy mesh's diagonal instead of the clean one's", 'd is the bounding-box diagonal of V_clean, the truth we measure against', lambda c: np.sqrt(c.e2.mean()) / c.d_noisy),
+    _part(0, 'in E the mean runs over the 3n coordinates instead of the n vertices', "square the length of each vertex's displacement, then average over vertices", lambda c: np.sqrt(c.e2.mean() / 3) / c.d),
+    _part(0, 'E is the mean of the distances, not the root of the mean square', 'square each distance, average, then take the square root', lambda c: np.sqrt(c.e2).mean() / c.d),
+    _part(0, 'E is not rooted (this is E^2)', 'take the square root of the mean of |x_i - x_i^clean|^2, then divide by d', lambda c: c.e2.mean() / c.d**2),
+    _part(1, 'the mean angle is in radians, not degrees', 'np.degrees(angle)', lambda c: np.radians(c.theta.mean())),
+    _part(1, 'the normals are not of unit length: arccos of the dot of two cross products is no angle', 'divide each cross product by its length before the dot product', lambda c: c.raw.mean()),
+    Wrong('the mean angle is NaN: arccos got a dot product above 1 (normals not of unit length, or a rounding error above 1)', 'normalise the normals and clip the dot product to [-1, 1] before arccos', when=lambda a, r, c: np.isnan(a[1])),
+    _part(1, 'the angles are summed over the faces, not averaged', 'the mean over faces: every face counts once', lambda c: c.theta.sum()),
+    _part(1, 'the mean angle is weighted by the face areas: every face counts once', 'np.mean over the faces, unweighted', lambda c: c.theta @ c.A_clean / c.A_clean.sum()),
+    _part(2, 'the volume change is absolute (length^3), not relative', "divide vol - vol_clean by |vol_clean|", lambda c: c.vol - c.vol_clean),
+    _part(2, 'the volume change is absolute and the volumes lack the 1/6 of a tetrahedron', 'vol = sum_f x0 . (x1 x x2) / 6; then (vol - vol_clean) / |vol_clean|', lambda c: 6 * (c.vol - c.vol_clean)),
+    _part(2, 'the volume change is divided by the new volume, not the clean one', '(vol - vol_clean) / |vol_clean|', lambda c: (c.vol - c.vol_clean) / c.vol),
+    _part(2, 'this is the ratio vol / vol_clean, not the relative change', 'subtract 1: (vol - vol_clean) / |vol_clean|', lambda c: c.vol / c.vol_clean),
+    _part(2, 'the sign of the volume change is flipped: a mesh that shrank must give a negative change', '(vol - vol_clean), not (vol_clean - vol)', lambda c: (c.vol_clean - c.vol) / c.vol_clean),
+    _part(2, "the tetrahedra's volumes are taken unsigned: the divergence theorem needs their signs", 'sum the signed x0 . (x1 x x2) / 6 (no abs): the parts outside the mesh cancel', lambda c: (c.unsigned - c.unsigned_clean) / c.unsigned_clean),
+    Wrong('the measures differ from the right ones on {label}', 'E over the clean diagonal, the mean face-normal angle in degrees, the signed relative volume change', typical=False),
 ]
 # fmt: on
 
 
-@exercise(
-    "vertex_rms",
-    reread="section 3 · The error, yours",
-    forbid=("lessons.metrics.vertex_rms", "lessons.metrics.denoising_metrics", "lessons.metrics.MeshComparison"),
-)
-def vertex_rms(fn):
-    """Check ``fn(V, V_clean) -> float``: sqrt(mean_i |x_i - x_i^clean|^2) / d(V_clean)."""
-    cases = _rms_cases()
-    hint = "average over all vertices and return one float, the RMS distance divided by the diagonal"
-    answers = run(fn, cases, lambda out, n: np.array([number(out, hint=hint)]))
-    judge(RMS_MISTAKES, cases, answers, right=lambda c: np.array([np.sqrt(c.e2.mean()) / c.d]))
+@exercise("denoising_metrics", reread="section 3 · The measures, yours", forbid=_METRICS, own=named("lessons.metrics", "vertex_rms face_normal_angles volume_change"))  # fmt: skip
+def denoising_metrics(fn):
+    """Check ``fn(V, V_clean, F) -> {"rms": E, "normal_mean": degrees, "volume_change": signed fraction}``."""
+    cases = _measure_cases()
+    answers = [_measures(answer(fn, c), c) for c in cases]
+    judge(MEASURE_MISTAKES, cases, answers, right=lambda c: c.right / c.scale)
     return [c.label for c in cases]
 
 
@@ -267,7 +288,7 @@ EXPERIMENT_MISTAKES = [
     _scalar('the error is sqrt(3) too small (its square a third of the right one): the mean runs over the 3n coordinates instead of the n vertices', 'average |p_i - x_i|^2 over the n vertices', lambda c: _e(c) / np.sqrt(3)),
     _scalar('the noise is sqrt(3) too small (its square a third of the right one): each vertex moved by a random direction of length sigma * d, so each coordinate moves by only sigma * d / sqrt(3)', 'draw every coordinate with standard deviation sigma * d', lambda c: _e(c, directions=True)),
     _scalar('the error is measured against the noisy mesh (the input of the smoothing), not against the clean mesh, the truth', 'return the RMS distance between the smoothed mesh and V_clean', lambda c: _e(c, key='noisy')),
-    _scalar('the error is measured against the noisy mesh W (as my_vertex_rms(P, W)), not against the clean mesh, the truth', 'return my_vertex_rms(P, V_clean): the smoothed mesh against V_clean', lambda c: _e(c, key='noisy d')),
+    _scalar('the error is measured against the noisy mesh W (as my_denoising_metrics(P, W, F)), not against the clean mesh, the truth', 'measure the smoothed mesh against V_clean: my_denoising_metrics(P, V_clean, F)', lambda c: _e(c, key='noisy d')),
     _scalar('the error is that of the noisy mesh: the smoothed mesh is not the one measured', 'smooth the noisy mesh and measure the result against V_clean', lambda c: _e(c, key='noise')),
     _scalar('the clean mesh was smoothed instead of the noisy one', 'smooth W = V_clean + noise, then compare with V_clean', lambda c: _e(c, sigma=0.0)),
     Wrong("on {label} the error differs from geomlib's run (by more than 5 %, or at all without noise)", 'smooth with geomlib.implicit_smoothing(W, F, tau, iterations) (cotangent weights)', typical=False),
@@ -282,15 +303,7 @@ def _same_e(a, r, c):
 @exercise(
     "denoising_experiment",
     reread="section 4 · The experiment, yours",
-    forbid=(
-        "lessons.noise.denoising_experiment",
-        "lessons.noise.add_noise",
-        "lessons.metrics.vertex_rms",
-        "lessons.metrics.denoising_metrics",
-        "lessons.metrics.MeshComparison",
-        "teaching.experiments.sweep.smoothing_sweep",
-        "teaching.experiments.sweep.denoising_comparison",
-    ),
+    forbid=(*named("lessons.noise", "denoising_experiment add_noise"), *_METRICS, *_SWEEPS),
     allow=("lessons.smoothing.implicit_smoothing",),
 )
 def denoising_experiment(fn):
@@ -395,7 +408,7 @@ def _wrong(diagnosis, hint, make):
 
 # fmt: off
 SWEEP_MISTAKES = [
-    _wrong('the error is measured against the noisy mesh W (E[:, 0] is 0), not against V_clean', 'E = my_vertex_rms(P, V_clean)', lambda c: _best(c.tables['noisy'], c.taus)),
+    _wrong('the error is measured against the noisy mesh W (E[:, 0] is 0), not against V_clean', 'E[i, k] = my_denoising_metrics(P, V_clean, F)["rms"]', lambda c: _best(c.tables['noisy'], c.taus)),
     _wrong("each step's run starts where the previous step's ended, not from the noisy mesh W", "set P = W before each step's iterations", lambda c: _best(c.tables['carry'], c.taus)),
     _wrong("M and C are rebuilt from the smoothed mesh at every iteration: the sweep keeps W's operator", 'build M, C = laplacian(W, F) once, before the loops', lambda c: _best(c.tables['rebuild'], c.taus)),
     _wrong('these are explicit steps, P + tau M^-1 C P, not implicit ones', "solve (M - tau C) P' = M P at every iteration", lambda c: _best(c.tables['explicit'], c.taus)),
@@ -407,7 +420,7 @@ SWEEP_MISTAKES = [
     _wrong('the best setting is the largest error (argmax), not the smallest', 'np.argmin over the whole table', lambda c: _best(c.right[2], c.taus, pick=np.argmax)),
     _wrong('N_best is one too many: the count of column k is k, not k + 1', 'the column index k is the number of steps', lambda c: _best(c.right[2], c.taus, count_from=1)),
     _wrong('tau_best is the index of the best step, not the step itself', 'return taus[i], not i', lambda c: _best(c.right[2], c.taus, index=True)),
-    Wrong('the table or the best setting differs from the right one on {label}', 'E[i, k] = my_vertex_rms after k implicit steps of taus[i]', typical=False),
+    Wrong('the table or the best setting differs from the right one on {label}', 'E[i, k] = the error E after k implicit steps of taus[i]', typical=False),
 ]
 # fmt: on
 
@@ -416,14 +429,10 @@ SWEEP_MISTAKES = [
     "denoising_sweep",
     reread="section 5 · The sweep, yours",
     forbid=(
-        "lessons.noise.denoising_sweep",
-        "lessons.smoothing.implicit_smoothing",
-        "lessons.smoothing.ImplicitSmoother",
-        "lessons.noise.denoising_experiment",
-        "lessons.metrics.vertex_rms",
-        "lessons.metrics.MeshComparison",
-        "teaching.experiments.sweep.smoothing_sweep",
-        "teaching.experiments.sweep.denoising_comparison",
+        *named("lessons.noise", "denoising_sweep denoising_experiment"),
+        *named("lessons.smoothing", "implicit_smoothing ImplicitSmoother"),
+        *_METRICS,
+        *_SWEEPS,
     ),
     allow=("lessons.laplace.laplacian",),
 )
@@ -433,3 +442,75 @@ def denoising_sweep(fn):
     answers = [_sweep_flat(answer(fn, c), c) for c in cases]
     judge(SWEEP_MISTAKES, cases, answers, right=lambda c: _sweep_flat(c.right, c))
     return [c.label + f" ({len(c.taus)} steps, {c.iterations} iterations)" for c in cases]
+
+
+# ------------------------------------------------------------------ Taubin's pairs
+# an open bump (its boundary held) and a closed icosphere, placed anew; pairs and steps chosen so that every
+# wrong count and step of the catalogue differs from the right one on one of them
+_TAUBIN_CASES = (
+    ("a 4 x 4 bump (open)", bump_4x4, 0.5, -0.53, 3),
+    ("a jittered icosphere", jittered_icosphere, 0.33, -0.34, 4),
+)
+
+
+def _taubin_cases():
+    rng, cases = case_rng(), []
+    for label, mesh, tau_shrink, tau_inflate, pairs in _TAUBIN_CASES:
+        V, F = placed(*mesh(), rng, jitter=0.1)
+        cases.append(Case(label, V=V, F=F, tau_shrink=tau_shrink, tau_inflate=tau_inflate, pairs=pairs))
+    return [c.but(right=taubin_pairs(c.V, c.F, c.tau_shrink, c.tau_inflate, c.pairs)) for c in cases]
+
+
+def _pairs_run(c, taus=None, weights="uniform", held=True, divide=True, rebuild=False):
+    """Explicit steps of ``taus`` (default: the pairs of the case) on (c.V, c.F), done right or in a wrong way."""
+    from ...lessons.laplace import laplacian
+    from ...mesh.topology import boundary_vertices
+
+    taus = [c.tau_shrink, c.tau_inflate] * c.pairs if taus is None else taus
+    move = np.ones(len(c.V), bool)
+    move[boundary_vertices(c.F, len(c.V))] = not held
+    P, (M, C) = c.V.copy(), laplacian(c.V, c.F, weights)
+    for tau in taus:
+        M, C = laplacian(P, c.F, weights) if rebuild else (M, C)
+        m = M.diagonal() if divide else np.ones(len(P))
+        P[move] += tau * (C @ P)[move] / m[move, None]
+    return P
+
+
+def _steps(c, shrink, inflate, pairs=None):
+    return [shrink, inflate] * (c.pairs if pairs is None else pairs)
+
+
+# fmt: off
+TAUBIN_MISTAKES = [
+    Wrong("the inflate step has the wrong sign: both steps shrink", "tau_inflate < 0 is given negative: add tau_inflate M^-1 C P, as the shrink step adds tau_shrink M^-1 C P", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, -c.tau_inflate))),
+    Wrong("the same step twice: each pair is two shrink steps of tau_shrink", "the second step of a pair uses tau_inflate", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_shrink))),
+    Wrong("only the shrink step: the inflate step is missing", "a pair is a step of tau_shrink, then one of tau_inflate", build=lambda c: _pairs_run(c, [c.tau_shrink] * c.pairs)),
+    Wrong("both steps are taken from the same P (P + (tau_shrink + tau_inflate) M^-1 C P): the inflate step must act on the shrunk positions", "update P with the shrink step, then apply the inflate step to that new P", build=lambda c: _pairs_run(c, [c.tau_shrink + c.tau_inflate] * c.pairs)),
+    Wrong("the sign of the Laplacian is flipped: the shrink step inflates", "P + tau M^-1 C P with C negative semidefinite (its diagonal negative)", build=lambda c: _pairs_run(c, _steps(c, -c.tau_shrink, -c.tau_inflate))),
+    Wrong("steps were counted instead of pairs: `pairs` explicit steps in all", "repeat the pair (shrink, then inflate) `pairs` times: 2 * pairs steps", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_inflate)[: c.pairs])),
+    Wrong("one pair short", "range(pairs), from 0: pairs repetitions", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_inflate, c.pairs - 1))),
+    Wrong("one pair too many", "range(pairs): exactly pairs repetitions", build=lambda c: _pairs_run(c, _steps(c, c.tau_shrink, c.tau_inflate, c.pairs + 1))),
+    Wrong("the boundary vertices moved: they are held where they are", "update only the interior vertices (not those of geomlib.boundary_vertices(F, n))", build=lambda c: _pairs_run(c, held=False)),
+    Wrong("M^-1 is missing: P + tau C P, not P + tau M^-1 C P", "divide each row of C P by the valence M_ii", build=lambda c: _pairs_run(c, divide=False)),
+    Wrong("cotangent weights: Taubin's filter here uses the uniform operator", 'geomlib.laplacian(V, F, "uniform")', build=lambda c: _pairs_run(c, weights="cotan")),
+    Wrong("cotangent weights, rebuilt from the moved mesh at every step: Taubin's filter here uses the uniform operator", 'geomlib.laplacian(V, F, "uniform"), built once (it depends on F alone)', build=lambda c: _pairs_run(c, weights="cotan", rebuild=True)),
+    Wrong("the positions differ from Taubin's pairs on {label}", "pairs times: P <- P + tau_shrink M^-1 C P, then P <- P + tau_inflate M^-1 C P, boundary held", typical=False),
+]
+# fmt: on
+
+
+@exercise(
+    "taubin_smoothing",
+    reread="section 6 · Taubin's filter, yours",
+    forbid=named("lessons.smoothing", "taubin_smoothing explicit_step explicit_smoothing ExplicitSmoother") + _SWEEPS,
+    allow=("lessons.laplace.laplacian", "mesh.topology.boundary_vertices"),
+)
+def taubin_smoothing(fn):
+    """Check ``fn(V, F, tau_shrink, tau_inflate, pairs) -> P`` against geomlib's :func:`taubin_smoothing`."""
+    cases = _taubin_cases()
+    answers = run(
+        fn, cases, lambda out, n: positions(out, n, nan_hint="a step past the limit diverges: check the signs")
+    )
+    judge(TAUBIN_MISTAKES, cases, answers, right=lambda c: c.right)
+    return [f"{c.label}, {c.pairs} pairs ({c.tau_shrink}, {c.tau_inflate})" for c in cases]

@@ -1,4 +1,4 @@
-"""Checks of notebook 04: the eigenpairs by the reduction to Q, and the reconstruction V_k = E_k E_k^T M V.
+"""Checks of notebook 04: the eigenpairs by the reduction to Q, and the reconstructions V_k = E_k E_k^T M V with their errors.
 
 Cases, placed anew each run (``case_rng``), small enough for a dense solve and for ``eigsh`` (every k < n): a
 jittered 42-vertex ellipsoid (closed; areas differing by about 2.25, so M matters), an open jittered 49-vertex
@@ -6,17 +6,19 @@ saddle (the natural boundary condition: the null mode is still the constant) and
 eigenvalues repeat. There k = 4 (the constant and the threefold lam_1): at k = 9 ``eigsh`` missed one of the five
 copies of lam_4 in 44 of 200 runs, at k = 4 none in 200. ``eigenpairs`` is judged by what defines the answer (lam
 ascending, C E = -M E diag(lam), E^T M E = I; signs and bases of repeated eigenspaces free) and refuses a
-generalised solver (:mod:`.solvers`); a reconstruction does not depend on the signs, so its mistakes are rebuilt
-from one dense basis.
+generalised solver (:mod:`.solvers`). The reconstruction study is handed the check's own dense solve, so its
+mistakes are rebuilt from the very basis it got (a student's own solve may differ in signs, which V_k ignores);
+the positions are judged first, then the errors, by their definition and not by Parseval.
 """
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse as sp
 
 from ...lessons.laplace import laplacian
 from ...mesh.topology import boundary_vertices
 from ..shapes.surfaces import ellipsoid, saddle, sphere
-from .catalogue import Case, Wrong, agree, judge, named, positions
+from .catalogue import Case, Wrong, agree, answer, judge, named, positions
 from .catalogue import eigenpairs as pair
 from .meshes import placed
 from .result import Mistake, call, case_rng, exercise
@@ -83,7 +85,7 @@ E_MISTAKES = [
 ]
 # fmt: on
 
-_SPECTRAL = "eigenpairs eigenbasis spectral_basis SpectralBasis spectral_reconstruction"
+_SPECTRAL = "eigenpairs eigenbasis spectral_basis SpectralBasis spectral_reconstruction spectral_reconstructions"
 
 
 @exercise(
@@ -108,20 +110,30 @@ def eigenpairs(fn):
     return [f"{c.label} with k = {c.k}" for c in cases]
 
 
-# ---------------------------------------------------------------- the reconstruction V_k = E_k E_k^T M V
+# ---------------------------------------------------------------- the study: V_k for each k of ks from one solve, and its error
 
 
-def _project(c, k=None, first=0, inner=lambda c, X: c.m[:, None] * X, E=None, left=False):
-    Ek = (c.E if E is None else E)[:, first : (c.k if k is None else k)]
-    X = Ek @ (Ek.T @ inner(c, c.V))
-    return c.m[:, None] * X if left else X
+def _solve(M, C, k):
+    """The eigen-solve handed to the function: the k smallest pairs of the (M, C) it is given, dense, by the
+    reduction (NaN when M's diagonal is not positive: (M, C) swapped)."""
+    m = np.asarray(M.diagonal(), dtype=float)
+    if not (m > 0).all():
+        return np.full(k, np.nan), np.full((len(m), k), np.nan)
+    lam, Z = _eig(sp.csr_matrix(C), 1 / np.sqrt(m))
+    return lam[:k], Z[:, :k] / np.sqrt(m)[:, None]
 
 
 def _basis_of(V, F, weights="cotan", area="barycentric"):
-    """(m, lam, E): the vertex areas and every eigenpair of C e = -lam M e, by the reduction, dense."""
+    """(m, lam, E): the vertex areas and every eigenpair of C e = -lam M e, as ``_solve`` gives them."""
     M, C = laplacian(V, F, weights=weights, area=area)
-    lam, Z = _eig(C, 1 / np.sqrt(m := M.diagonal()))
-    return m, lam, Z / np.sqrt(m)[:, None]
+    return M.diagonal(), *_solve(M, C, len(V))
+
+
+def _project(c, shift=0, first=0, inner=lambda c, X: c.m[:, None] * X, E=None, left=False):
+    """[V_k for k in c.ks]: V_k = E_k E_k^T (inner V), k + shift columns from e_first on."""
+    E, W = c.E if E is None else E, inner(c, c.V)
+    X = np.stack([E[:, first : k + shift] @ (E[:, first : k + shift].T @ W) for k in c.ks])
+    return c.m[:, None] * X if left else X
 
 
 def _boundary_rows(c):
@@ -131,73 +143,76 @@ def _boundary_rows(c):
 
 
 def _in_uniform_span(a, c):
-    """Whether V_k lies in the span of the uniform eigenvectors up to lam_{k-1}'s whole eigenspace, which
+    """Whether each V_k lies in the span of the uniform eigenvectors up to lam_{k-1}'s whole eigenspace, which
     repeats on a subdivided icosahedron's graph: any basis of a cut eigenspace gives another V_k."""
     m, lam, E = _basis_of(c.V, c.F, weights="uniform")
-    S = E[:, lam <= lam[c.k - 1] + 1e-9 * lam[-1]]
-    return agree(S @ (S.T @ (m[:, None] * a)), a)
+    spans = [E[:, lam <= lam[k - 1] + 1e-9 * lam[-1]] for k in c.ks]
+    return all(agree(S @ (S.T @ (m[:, None] * X)), X) for S, X in zip(spans, a))
 
 
-def _eig_rows(c):
-    lam, U = np.linalg.eig(-c.C.toarray())
-    U = U.real[np.argsort(lam.real)][:, : c.k]
-    return U @ (U.T @ c.V)
+def _scaled(a, b):
+    """Whether a is b times one factor (a normalisation of its own, or none)."""
+    return a[-1] != 0 and np.isfinite(a).all() and agree(a * (b[-1] / a[-1]), b)
 
 
-def _other_basis(c, **options):
-    m, _, E = _basis_of(c.V, c.F, **options)
-    return E[:, : c.k] @ (E[:, : c.k].T @ (m[:, None] * c.V))
-
-
-_UNIFORM = ("the uniform operator (valences, weights 1) is used where the cotangent one is asked",
-            "laplacian(V, F) with its default weights")  # fmt: skip
 # fmt: off
-RECONSTRUCTION_MISTAKES = [
+POSITION_MISTAKES = [
     Wrong('the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs', 'E^T M E = I, so the coefficients are E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: X)),
     Wrong('V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)', 'c = E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None])),
     Wrong('M multiplies the result (M E_k E_k^T V) instead of V inside the inner product', 'V_k = E_k (E_k^T (M V))', build=lambda c: _project(c, inner=lambda c, X: X, left=True)),
-    Wrong('C stands where M belongs in the inner product', 'the coefficients are E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: c.C @ X)),
-    Wrong('the constant eigenvector e_0 is dropped and the plain inner product is used: two mistakes', 'E[:, :k], e_0 included, and E_k^T M V', build=lambda c: _project(c, first=1, inner=lambda c, X: X)),
     Wrong('the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin', 'use E[:, :k], e_0 included', build=lambda c: _project(c, first=1)),
-    Wrong('k is off by one: one eigenvector too few', 'E[:, :k] holds e_0 .. e_{k-1}', build=lambda c: _project(c, k=c.k - 1)),
-    Wrong('k is off by one: one eigenvector too many', 'E[:, :k] holds e_0 .. e_{k-1}', build=lambda c: _project(c, k=c.k + 1)),
-    Wrong(*_UNIFORM, build=lambda c: _other_basis(c, weights='uniform')),
-    Wrong(*_UNIFORM, when=lambda a, right, c: _in_uniform_span(a, c)),
-    Wrong('the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked', 'laplacian(V, F) with its default area', build=lambda c: _other_basis(c, area='mixed')),
+    Wrong('the mean is taken out twice: V is centred by its plain mean and e_0, which carries the area-weighted mean, is dropped too', 'no centring is needed: e_0 carries the mean', build=lambda c: _project(c, first=1) + c.V.mean(axis=0)),
+    Wrong('V is centred by its mean and the mean is not added back: V_k sits at the origin', 'project V itself: e_0 carries the mean', build=lambda c: _project(c) - c.V.mean(axis=0)),
+    Wrong('k is off by one: one eigenvector too few', 'V_k holds e_0 .. e_{k-1}, E[:, :k]', build=lambda c: _project(c, shift=-1)),
+    Wrong('k is off by one: one eigenvector too many (k + 1 of them)', 'V_k holds e_0 .. e_{k-1}, E[:, :k]', when=lambda a, right, c: agree(a[0], _project(c, shift=1)[0])),
+    Wrong('the uniform operator (valences, weights 1) is used where the cotangent one is asked', 'laplacian(V, F) with its default weights', when=lambda a, right, c: _in_uniform_span(a, c)),
+    Wrong('the mixed (Voronoi) vertex areas of Meyer et al. 2003 are used where the barycentric M is asked', 'laplacian(V, F) with its default area', build=lambda c: _project(c.but(m=(b := _basis_of(c.V, c.F, area='mixed'))[0]), E=b[2])),
     Wrong('the rows of the boundary vertices are zeroed, so C is not symmetric: wrong on an open mesh', 'keep every row of C: the natural boundary condition needs no rule', build=_boundary_rows),
-    Wrong('two mistakes: M is left out (the eigenvectors of -C alone), and the rows of the eigenvector matrix are sorted and taken where its columns are the eigenvectors', 'E[:, order] and E[:, :k] of C e = -lam M e', build=_eig_rows),
     Wrong('V_k differs from the M-orthogonal projection on {label}', 'V_k = E_k (E_k^T M V)', typical=False),
+]
+
+_ERROR = 'sqrt(||V - V_k||_M^2 / area) / diag'
+ERROR_MISTAKES = [
+    Wrong('the errors are not relative: ||V - V_k||_M itself', f'{_ERROR}, area = sum of the A_i', build=lambda c: c.norms),
+    Wrong('the errors are not divided by the bounding-box diagonal', f'{_ERROR}, diag = |max - min| of the coordinates', build=lambda c: c.norms / np.sqrt(c.m.sum())),
+    Wrong('the square root is missing: squared distances', _ERROR, when=lambda a, right, c: _scaled(a, right**2) and not agree(a, right)),
+    Wrong('the vertices are weighted equally (the Euclidean norm), not by their areas A_i', f'||X||_M^2 = sum_i A_i |x_i|^2, so {_ERROR}', when=lambda a, right, c: _scaled(a, c.plain)),
+    Wrong('the errors are right up to one factor on {label}: another normalisation', _ERROR, when=lambda a, right, c: _scaled(a, right) and not agree(a, right)),
+    Wrong(f'the errors differ from {_ERROR} on {{label}}', 'measure V - V_k itself, in the M-norm', typical=False),
 ]
 # fmt: on
 
 
-def _positions(fn, c):
-    try:
-        out = call(fn, c.V.copy(), c.F.copy(), c.k)
-    except Mistake as m:  # geomlib's eigenpairs, handed C as M, says it is not diagonal
-        if "must be diagonal" not in m.diagnosis:
-            raise
-        raise Mistake("(M, C) are swapped: laplacian returns M first", "M, C = laplacian(V, F)") from None
-    if np.shape(out) == (c.k, 3):
-        diagnosis = f"the function returned the {c.k} x 3 coefficients E_k^T M V, not the positions"
-        raise Mistake(diagnosis, "multiply them back: V_k = E_k c", typical=False)
-    if np.shape(out) == (c.n, 3) and np.asarray(out).dtype.kind == "f" and not np.isfinite(out).all():
+def _study(fn, c):
+    """(V_ks (len(ks), n, 3), err (len(ks),)) the function returned on case c, as float arrays."""
+    out, count = answer(fn, c), len(c.ks)
+    if not isinstance(out, (tuple, list)) or len(out) != 2 or len(out[0]) != count or np.shape(out[1]) != (count,):
+        diagnosis = f"the function returned {type(out).__name__}, not the pair (V_ks, err) for the {count} counts in ks"
+        raise Mistake(diagnosis, "return the list of V_k and the array of errors, one each per k of ks", typical=False)
+    if not np.isfinite(np.asarray(out[0], dtype=float)).all():
         diagnosis = "the positions are NaN, as when (M, C) are swapped: C's diagonal, negative, went in as the "
         raise Mistake(diagnosis + "vertex areas and under a square root", "M, C = laplacian(V, F): M first")
-    return positions(out, c.n)
+    return np.stack([positions(X, c.n, "V_k") for X in out[0]]), np.asarray(out[1], dtype=float)
 
 
 @exercise(
     "spectral_reconstruction",
     reread="section 4 · Reconstruction from the first k eigenvectors",
-    forbid=named("lessons.spectral", "spectral_reconstruction spectral_basis SpectralBasis"),
+    forbid=named("lessons.spectral", "spectral_reconstructions spectral_reconstruction spectral_basis SpectralBasis"),
     allow=("lessons.laplace.laplacian", "lessons.spectral.eigenpairs"),
 )
 def spectral_reconstruction(fn):
-    """Check ``fn(V, F, k) -> V_k``: V_k = E_k E_k^T M V with E_k the first k eigenvectors (every k < n)."""
+    """Check ``fn(V, F, ks, solve) -> (V_ks, err)``: V_k = E_k E_k^T M V for each k, the eigenpairs from the
+    check's ``solve`` (any number of calls), and the error sqrt(||V - V_k||_M^2 / area) / diag of each."""
     meshes, cases = _meshes(case_rng()), []
-    for (label, V, F), k in ((meshes[0], 5), (meshes[0], 12), (meshes[1], 8)):
+    for (label, V, F), ks in ((meshes[0], [1, 4, 12]), (meshes[1], [3, 8])):
         m, _, E = _basis_of(V, F)
-        cases.append(Case(label, V=V, F=F, k=k).but(m=m, E=E, C=laplacian(V, F)[1]))
-    judge(RECONSTRUCTION_MISTAKES, cases, [_positions(fn, c) for c in cases], right=_project)
-    return [f"{c.label} with k = {c.k}" for c in cases]
+        c = Case(label, V=V, F=F, ks=ks, solve=_solve).but(m=m, E=E, diag=np.linalg.norm(np.ptp(V, axis=0)))
+        gap = _project(c) - V
+        norms = np.sqrt(np.einsum("i,kij,kij->k", m, gap, gap))
+        plain = np.sqrt(np.einsum("kij,kij->k", gap, gap) / len(m)) / c.diag
+        cases.append(c.but(norms=norms, err=norms / np.sqrt(m.sum()) / c.diag, plain=plain))
+    answers = [_study(fn, c) for c in cases]
+    judge(POSITION_MISTAKES, cases, [a[0] for a in answers], right=_project)
+    judge(ERROR_MISTAKES, cases, [a[1] for a in answers], right=lambda c: c.err)
+    return [f"{c.label} with ks = {c.ks}" for c in cases]

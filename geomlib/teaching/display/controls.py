@@ -34,8 +34,9 @@ import warnings
 import numpy as np
 
 from ...mesh.errors import MeshError, MeshWarning
+from ..notebook import text_only
 from .stills import png_base64
-from .viewer import MeshView, ViewRow, box_alt, box_still, register_still, stills_only
+from .viewer import MeshView, ViewRow, box_alt, box_still, register_still
 
 __all__ = ["live", "Live", "live_figure", "LiveFigure", "mesh_warnings"]
 
@@ -91,11 +92,13 @@ class Live:
         self.readout.value = "<code>" + "<br>".join(html.escape(line) for line in lines) + "</code>"
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        # while nbgrader runs the notebook its feedback page is static HTML: the still and the read-out only
-        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        # while nbgrader runs the notebook its feedback page is static HTML: the read-out only
+        text = html.unescape(self.readout.value.replace("<br>", "\n")).replace("<code>", "").replace("</code>", "")
+        if text_only():
+            return {"text/plain": text}
+        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         still = box_still(self.widget)
-        bundle["text/plain"] = html.unescape(self.readout.value.replace("<br>", "\n")).replace("<code>", "")
-        bundle["text/plain"] = bundle["text/plain"].replace("</code>", "")
+        bundle["text/plain"] = text
         if still is None:
             return bundle
         bundle["image/png"] = png_base64(still)
@@ -162,6 +165,10 @@ class LiveFigure:
         values = {name: control.value for name, control in self.controls.items()}
         if self._drawn is None or self._drawn[0] != values:
             fig, alt = self.draw(**values)
+            if text_only():  # the alt text only: nothing drawn
+                plt.close(fig)
+                self._drawn = values, None, " ".join(str(alt).split())
+                return self._drawn
             buffer = io.BytesIO()
             fig.savefig(buffer, format="png", bbox_inches="tight")  # framed as show_figure frames it
             plt.close(fig)
@@ -177,10 +184,16 @@ class LiveFigure:
         """The figure's alt text at the controls' current values."""
         return self._picture()[2]
 
+    def summary(self):
+        """The figure's text: its alt text at the controls' current values."""
+        return f"Figure: {self.alt_text()}"
+
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        if text_only():
+            return {"text/plain": self.summary()}
+        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle["text/plain"] = self.summary()
         bundle["image/png"] = png_base64(self.still())
-        bundle["text/plain"] = f"Figure: {self.alt_text()}"
         return bundle, {"image/png": {"alt": self.alt_text()}}
 
 

@@ -110,9 +110,10 @@ so does the first view) every box holding views has a still picture of them
 (``box_still``), side by side.
 
 While nbgrader runs a notebook (``autograde``, ``validate``) a view gives its
-still picture and summary only, without the widget (``stills_only``), and other
-widgets their text: the feedback pages are static HTML without widget
-state, where a widget would be an empty placeholder.
+one-line summary only, without the widget or a still picture, a box of views the
+summaries, and other widgets their text (``geomlib.teaching.notebook.text_only``):
+the feedback pages are static HTML without widget state, where a widget would be
+an empty placeholder, and no grade cell needs a picture.
 """
 
 import html
@@ -124,7 +125,7 @@ from ...mesh.errors import MeshError, format_indices
 from ...mesh.geometry import enclosed_volume
 from ...mesh.topology import Topology, edges
 from ...mesh.validate import as_faces, as_vertices, check_choice, repeated_vertex_faces
-from ..notebook import graded
+from ..notebook import text_only
 from .colours import (
     NAN_COLOR,
     NAN_NAME,
@@ -161,7 +162,7 @@ __all__ = [
     "side_by_side",
     "box_still",
     "box_alt",
-    "stills_only",
+    "box_text",
     "register_still",
     "setup_display",
 ]
@@ -733,9 +734,11 @@ class MeshView:
         return text
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
-        bundle["image/png"] = png_base64(self.still())
+        if text_only():
+            return {"text/plain": self.summary()}
+        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
         bundle["text/plain"] = self.summary()
+        bundle["image/png"] = png_base64(self.still())
         return bundle, {"image/png": {"alt": self.alt_text()}}
 
     def __repr__(self):
@@ -755,14 +758,20 @@ class ViewRow:
         """(h, w, 3) uint8: the still pictures of the views next to each other."""
         return in_a_row([v.still(distance=self._distance) for v in self.views])
 
+    def summary(self):
+        """The views' one-line summaries, left to right, one per line."""
+        return "\n".join(v.summary() for v in self.views)
+
     def alt_text(self):
         """The text alternatives of the views, left to right, in one text."""
         return " ".join(f"View {k} of {len(self.views)}: {v.alt_text()}" for k, v in enumerate(self.views, 1))
 
     def _repr_mimebundle_(self, include=None, exclude=None, **kwargs):
-        bundle = {} if stills_only() else self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        if text_only():
+            return {"text/plain": self.summary()}
+        bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude) or {}
+        bundle["text/plain"] = self.summary()
         bundle["image/png"] = png_base64(self.still())
-        bundle["text/plain"] = "\n".join(v.summary() for v in self.views)
         return bundle, {"image/png": {"alt": self.alt_text()}}
 
     def __repr__(self):
@@ -776,7 +785,8 @@ _SHOWN = weakref.WeakValueDictionary()
 
 def register_still(widget, shown):
     """Let a box holding ``widget`` be drawn as ``shown.still()`` ((h, w, 3) uint8), described by
-    ``shown.alt_text()``: what :func:`box_still` and :func:`box_alt` find for it, as for a view."""
+    ``shown.alt_text()`` and summed up by ``shown.summary()``: what :func:`box_still`,
+    :func:`box_alt` and :func:`box_text` find for it, as for a view."""
     _SHOWN[widget.model_id] = shown
 
 
@@ -817,25 +827,32 @@ def box_alt(box):
     return " ".join(texts)
 
 
+def box_text(box):
+    """The summaries of the views (and figures) inside an ipywidgets box, one per line ("" if it holds none)."""
+    texts = []
+
+    def collect(widget):
+        shown = _SHOWN.get(getattr(widget, "model_id", None))
+        if shown is not None:
+            texts.append(shown.summary())
+            return
+        for child in getattr(widget, "children", ()):
+            collect(child)
+
+    collect(box)
+    return "\n".join(texts)
+
+
 def _box_png(box):
+    if text_only():
+        return None
     image = box_still(box)
     return None if image is None else (png_base64(image), {"alt": box_alt(box)})
 
 
-def stills_only():
-    """Whether views are shown as still pictures without their widgets: while nbgrader runs
-    the notebook, whose feedback pages are static HTML (a widget there is an empty placeholder)."""
-    return graded()
-
-
-def _widget_stills_only(widget):
-    image = box_still(widget)
-    if image is None:  # a slider, a progress bar, an Output widget: its text, as without a front-end
-        return {"text/plain": repr(widget)}
-    return (
-        {"image/png": png_base64(image), "text/plain": "still picture of the 3D views (live in Jupyter)"},
-        {"image/png": {"alt": box_alt(widget)}},
-    )
+def _widget_as_text(widget):
+    # a box of views: their summaries; a slider, a progress bar, an Output widget: its text, as without a front-end
+    return {"text/plain": box_text(widget) or repr(widget)}
 
 
 def setup_display():
@@ -843,8 +860,8 @@ def setup_display():
 
     In Colab, enables its custom widget manager (:func:`.frontends.enable_colab_widgets`),
     without which the 3D views are not drawn. In IPython, displays every ipywidgets box
-    with the still of its views as image/png (with ``stills_only``, every widget without
-    its widget view: a box as the still of its views, any other as its text), and draws
+    with the still of its views as image/png (with ``text_only``, every widget as text
+    alone: a box as the summaries of its views, any other as its text), and draws
     plots in :func:`.colours.plot_style`. Calling it again changes nothing; a
     :class:`MeshView` calls it when it is made, so a view is drawn in a reader's own
     notebook too.
@@ -857,8 +874,8 @@ def setup_display():
         import ipywidgets
 
         shell.display_formatter.formatters["image/png"].for_type(ipywidgets.Box, _box_png)
-        if stills_only():
-            shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_stills_only)
+        if text_only():
+            shell.display_formatter.mimebundle_formatter.for_type(ipywidgets.DOMWidget, _widget_as_text)
         # a notebook's own plots: colour-blind-safe colours, each with its own line style
         use_plot_style()
 

@@ -21,14 +21,12 @@ import time
 import warnings
 
 import numpy as np
-import scipy.sparse as sp
 
 from ...lessons.laplace import WEIGHTS
 from ...lessons.metrics import HAUSDORFF_SAMPLES_PER_FACE, MeshComparison
 from ...lessons.noise import add_noise
-from ...lessons.smoothing import BLOWUP_FACTOR, ExplicitSmoother, ImplicitSmoother, explicit_step_limit
+from ...lessons.smoothing import ExplicitSmoother, ImplicitSmoother, explicit_step_limit, taubin_smoothing
 from ...mesh.errors import MeshError, MeshWarning
-from ...mesh.geometry import bounding_box_diagonal
 from ...mesh.validate import check_choice
 from ...numerics import experiment_store
 from ...numerics.cores import CORES
@@ -438,7 +436,7 @@ def denoising_comparison(V_clean, F, sigmas, seed, grids=None, comparison=None, 
     once per step for its largest count, measured against the clean mesh after every count
     (:meth:`MeshComparison.evaluate`): explicit and implicit smoothing with the noisy mesh's
     operator of the given weights (:class:`ExplicitSmoother`, :class:`ImplicitSmoother`), and
-    Taubin's filter (Taubin 1995): pairs of :func:`explicit_step` with ``tau`` then ``-tau``
+    Taubin's filter (Taubin 1995): :func:`geomlib.taubin_smoothing` with the pair ``(tau, -tau)``
     on the uniform operator, boundary fixed. A run that diverges stops; its later entries stay NaN.
 
     Parameters
@@ -528,7 +526,8 @@ def _compare(comparison, out, i, j, seed):
         if key in out.noisy:
             out.noisy[key][i] = value
     (method, weights), (steps, counts) = out.methods[j], out.grids[out.methods[j]]
-    smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, comparison.F, weights)
+    if method != "taubin":  # Taubin's pairs run through taubin_smoothing, below
+        smoother = (ImplicitSmoother if method == "implicit" else ExplicitSmoother)(W, comparison.F, weights)
     out.limits[i, j] = limit = explicit_step_limit(W, comparison.F, weights)
     where = {k: l for l, k in enumerate(counts)}
     for k, fraction in enumerate(steps):
@@ -545,24 +544,6 @@ def _compare(comparison, out, i, j, seed):
                 smoother.smooth(fraction * limit, counts[-1], callback=record, on_failure="stop", progress=False)
             elif method == "implicit":
                 smoother.smooth(fraction * limit, counts[-1], callback=record, progress=False, P=W)
-            else:
-                _taubin(smoother, W, fraction * limit, counts, record)
-
-
-def _taubin(smoother, W, tau, counts, callback):
-    """Taubin's filter from W: ``pairs`` times an explicit step of ``tau`` (shrink) then of ``-tau`` (inflate).
-
-    Each step is :func:`explicit_step`'s ``P + tau M^-1 C P``, with ``M^-1 C`` multiplied out once
-    (thousands of pairs; the fixed vertices' rows of C are zero, so they stay in place).
-    """
-    L = (sp.diags(1.0 / smoother.L.M_step.diagonal()) @ smoother.L.C_step).tocsr()
-    far = BLOWUP_FACTOR * max(bounding_box_diagonal(W), np.finfo(float).tiny)  # as the explicit smoother's test
-    P = W
-    measured = set(counts)
-    for k in range(1, max(counts) + 1):
-        P = P + tau * (L @ P)
-        P = P - tau * (L @ P)
-        if k in measured:  # measured here, and tested for divergence (NaN fails too): then the rest stays NaN
-            if not np.abs(P - W).max() <= far:
-                return
-            callback(k, P)
+            else:  # Taubin's pairs (tau, -tau); a diverging run stops, its later cells stay NaN
+                tau = fraction * limit
+                taubin_smoothing(W, comparison.F, tau, -tau, counts[-1], weights, callback=record, on_failure="stop")
