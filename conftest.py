@@ -21,7 +21,7 @@ FILE_SECONDS = {
     "tests/browser/test_notebooks_browser.py": 269,
     "tests/test_nbgrader.py": 166,
     "tests/browser/test_accessibility.py": 132,
-    "tests/browser/test_frontends_browser.py": 112,
+    "tests/browser/test_frontends_browser.py": 90,
     "tests/test_integrity.py": 101,
     "tests/test_check_students.py": 87,
     "tests/test_install.py": 47,
