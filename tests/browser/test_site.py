@@ -3,11 +3,13 @@ with the network cut off.
 
 The site is built once per session into a temporary folder (every notebook
 executed; a few minutes), or taken from GEOMLIB_SITE_DIR when that names a
-folder built by ``python3 workbook.py site``. It is served by a static file
-server on a loopback port; every request that goes anywhere else is aborted
-and recorded, and the test asserts that there was none.
+folder built by ``python3 workbook.py site``. Every page is opened once, from
+``file://``, for both its offline checks and its accessibility audit (below); the
+index and the pages with precomputed sliders are opened again from a static file
+server on a loopback port. Every request that goes anywhere else is aborted and
+recorded, and the tests assert that there was none.
 
-On every page:
+On every notebook's page:
 1. no request left the machine, and no file of the site is missing;
 2. every 3D view's canvas shows a picture (not one flat colour), as many
    canvases as the build counted live views;
@@ -28,8 +30,24 @@ On the pages with precomputed sliders (01, 04, 05, 06, 07; the ones the course n
 listed in LIVE_SLIDERS), every such slider, moved with the keyboard, changes its
 cell's 3D view and read-out, and moved back restores the first picture exactly.
 
-The index lists every notebook in reading order, and a page opened from
-``file://`` works the same way (canvases drawn, nothing fetched from outside).
+The index lists every notebook in reading order.
+
+Every HTML page of the site (core notebooks, appendices, documentation, reference, index,
+and whatever other page the folder holds), settled (formulas typeset, views drawn, slider
+states wired), against WCAG 2.1 AA (issue 32), before the checks above touch it:
+
+1. axe-core 4.14.1 with its WCAG 2.0/2.1 A and AA rules: no serious or critical
+   violation (tests/browser/axe_audit.py; axe comes pinned from the npm registry
+   through the site builder's cached download);
+2. the page's own structure: a skip link to ``<main>`` first in the Tab order,
+   navigation bars labelled and outside ``<main>``, formulas out of the Tab order;
+3. on pages with widgets: every slider named, announcing the value its read-out shows
+   (a log slider's exponent is not what a reader sees) and, if disabled, out of the Tab
+   order and announced disabled; every image with an alt that is not nbconvert's
+   placeholder; every 3D view focusable, labelled, described by its text alternative
+   (mesh, vertices, faces) and by the visible line naming its keys; a polite live region;
+   slider tracks at 3:1 against the page; slider labels not cut under WCAG's text spacing;
+4. no uncaught exception.
 
 The site as a whole (no browser needed, on the same build): a page for every notebook
 (core and appendix), every markdown page (README, docs/) and the reference; previous/next
@@ -41,6 +59,7 @@ Screenshots: build/screenshots/site/.
 
 import functools
 import http.server
+import json
 import re
 import sys
 import threading
@@ -53,9 +72,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 
+import axe_audit  # noqa: E402
 import build_site  # noqa: E402
 
 NOTEBOOKS = [p.name for p in build_site.notebook_paths()]  # core and appendix, in reading order
+NOTEBOOK_OF = {Path(n).stem + ".html": n for n in NOTEBOOKS}  # page file -> its notebook
 SITE_BYTES = 60_000_000  # the whole folder (issue 30)
 SCREENSHOTS = ROOT / "build" / "screenshots" / "site"
 LOAD_TIMEOUT = 90  # seconds for a page's views and formulas to appear
@@ -100,6 +121,10 @@ class OfflinePage:
         self.page = self.context.new_page()
         self.page.on("request", self._request)
         self.page.on("response", lambda r: self.missing.append(f"{r.status} {r.url}") if r.status >= 400 else None)
+        # from file:// a missing file is a failed request, not a response with a status
+        self.page.on(
+            "requestfailed", lambda r: self.missing.append(f"{r.failure} {r.url}") if self._local(r.url) else None
+        )
         self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
         self.page.on("pageerror", lambda e: self.errors.append(f"uncaught: {e}"))
 
@@ -233,50 +258,104 @@ def _check_canvases(page, expected, shots):
     return canvases.count()
 
 
+def _offline_checks(view, notebook, pages):
+    """The checks 1-8 above on ``view``, the loaded page of ``notebook``; raises AssertionError."""
+    name = Path(notebook).stem + ".html"
+    shots = SCREENSHOTS / Path(notebook).stem
+    shots.mkdir(parents=True, exist_ok=True)
+    page = view.page
+    assert page.evaluate(JS_MATH_DONE), "MathJax did not load"
+    math = page.evaluate(JS_MATH)
+    markdown = "\n".join(
+        c.source for c in nbformat.read(build_site.NOTEBOOKS / notebook, 4).cells if c.cell_type == "markdown"
+    )
+    if re.search(r"\$[^$\s][^$]*\$", markdown):
+        assert math["formulas"] > 0, "the notebook has formulas but MathJax found none"
+    assert math["typeset"] >= math["formulas"], f"MathJax typeset {math['typeset']} of {math['formulas']} formulas"
+    assert math["errors"] == 0, f"{math['errors']} formulas show a TeX error"
+    assert math["raw"] == 0, f"{math['raw']} '$$' left untypeset in the text"
+
+    _check_canvases(page, pages[name]["views"], shots)
+
+    assert page.evaluate(JS_REVEAL_STILLS) == 0, "still pictures shown beside 3D views that drew"  # issue 23
+
+    controls = page.evaluate(JS_CONTROLS)
+    live = len(pages[name]["sliders"])
+    assert controls["enabled"] == live, f"{controls['enabled']} controls usable without a kernel, {live} precomputed"
+    if controls["controls"] > live:
+        assert controls["notes"] > 0, "controls are shown without the note that they need JupyterLab"
+    if live:
+        assert controls["snap_notes"] > 0, "precomputed sliders are shown without the note that they snap"
+    if controls["labels"]:  # widget text in JupyterLab's interface font, as in the workbook itself
+        assert controls["ui"], "the page does not define JupyterLab's --jp-ui-font-family"
+        assert controls["fonts"] == [controls["ui"]], f"widget labels in {controls['fonts']}, not {controls['ui']}"
+    page.screenshot(path=str(shots / "page.png"))
+    assert not view.outside, f"requests to the network: {view.outside}"
+    assert not view.missing, f"files missing from the site: {view.missing}"
+    assert not view.errors, "console errors:\n" + "\n".join(view.errors)
+
+
+def _audit(view, name, pages):
+    """axe's violations on the settled page, its structure (axe_audit.JS_PAGE) and the slider
+    labels cut under WCAG's text spacing."""
+    found = axe_audit.audit(view.page, pages.get(name, {}).get("views", 0))
+    return found, view.page.evaluate(axe_audit.JS_PAGE), view.page.evaluate(axe_audit.JS_SPACED_LABELS_CUT)
+
+
+def _visit(browser, folder, pages, name):
+    """Open page ``name`` of the site from ``file://`` once, offline, and run on it the WCAG audit
+    and, on a notebook's page, the offline checks (after the audit, which sees the page as a
+    reader first does): {"audit": (violations, structure, cut labels) or the exception it
+    raised, "offline": None or the exception, "uncaught": the page's uncaught exceptions}."""
+    view = OfflinePage(browser, folder.resolve().as_uri() + "/")
+    outcome = {"offline": None}
+    try:
+        try:
+            view.page.goto((folder / name).resolve().as_uri(), wait_until="load")
+            outcome["audit"] = _audit(view, name, pages)
+        except Exception as error:  # kept for the tests of this page to raise
+            outcome["audit"] = error
+        notebook = NOTEBOOK_OF.get(name)
+        if notebook:
+            try:
+                _offline_checks(view, notebook, pages)
+            except Exception as error:
+                outcome["offline"] = error
+        outcome["uncaught"] = [e for e in view.errors if e.startswith("uncaught: ")]
+    finally:
+        view.close()
+    return outcome
+
+
+def _raised(result):
+    """``result``, or what a visit's check raised, raised here."""
+    if isinstance(result, BaseException):
+        raise result
+    return result
+
+
+@pytest.fixture(scope="module")
+def visited(site, browser):
+    """``visited(name)``: the outcome of :func:`_visit` of page ``name``, which opens the page the
+    first time a test asks for it; so a notebook's page loads once for its offline test and
+    its accessibility test, in whatever order they run."""
+    folder, pages = site
+    done = {}
+
+    def visit(name):
+        if name not in done:
+            done[name] = _visit(browser, folder, pages, name)
+        return done[name]
+
+    return visit
+
+
 @pytest.mark.parametrize("notebook", NOTEBOOKS)
-def test_page_offline(notebook, site, site_url, browser):
+def test_page_offline(notebook, site, visited):
     _, pages = site
     name = Path(notebook).stem + ".html"
     assert name in pages, f"{name} was not built"
-    shots = SCREENSHOTS / Path(notebook).stem
-    shots.mkdir(parents=True, exist_ok=True)
-    view = OfflinePage(browser, site_url)
-    try:
-        page = view.page
-        page.goto(site_url + name, wait_until="load")
-        assert page.evaluate(JS_MATH_DONE), "MathJax did not load"
-        math = page.evaluate(JS_MATH)
-        markdown = "\n".join(
-            c.source for c in nbformat.read(build_site.NOTEBOOKS / notebook, 4).cells if c.cell_type == "markdown"
-        )
-        if re.search(r"\$[^$\s][^$]*\$", markdown):
-            assert math["formulas"] > 0, "the notebook has formulas but MathJax found none"
-        assert math["typeset"] >= math["formulas"], f"MathJax typeset {math['typeset']} of {math['formulas']} formulas"
-        assert math["errors"] == 0, f"{math['errors']} formulas show a TeX error"
-        assert math["raw"] == 0, f"{math['raw']} '$$' left untypeset in the text"
-
-        _check_canvases(page, pages[name]["views"], shots)
-
-        assert page.evaluate(JS_REVEAL_STILLS) == 0, "still pictures shown beside 3D views that drew"  # issue 23
-
-        controls = page.evaluate(JS_CONTROLS)
-        live = len(pages[name]["sliders"])
-        assert controls["enabled"] == live, (
-            f"{controls['enabled']} controls usable without a kernel, {live} precomputed"
-        )
-        if controls["controls"] > live:
-            assert controls["notes"] > 0, "controls are shown without the note that they need JupyterLab"
-        if live:
-            assert controls["snap_notes"] > 0, "precomputed sliders are shown without the note that they snap"
-        if controls["labels"]:  # widget text in JupyterLab's interface font, as in the workbook itself
-            assert controls["ui"], "the page does not define JupyterLab's --jp-ui-font-family"
-            assert controls["fonts"] == [controls["ui"]], f"widget labels in {controls['fonts']}, not {controls['ui']}"
-        page.screenshot(path=str(shots / "page.png"))
-        assert not view.outside, f"requests to the network: {view.outside}"
-        assert not view.missing, f"files missing from the site: {view.missing}"
-        assert not view.errors, "console errors:\n" + "\n".join(view.errors)
-    finally:
-        view.close()
+    _raised(visited(name)["offline"])
     assert not pages[name]["errors"], "cells raised errors while the site was built:\n" + "\n".join(
         pages[name]["errors"]
     )
@@ -304,22 +383,13 @@ def test_index_lists_pages_in_order(site, site_url, browser):
         view.close()
 
 
-def test_page_from_file_url(site, browser):
-    """The folder works without any server: the first page with views, opened from file://."""
-    folder, pages = site
+def test_page_from_file_url(site, visited):
+    """The folder works without any server: the first page with views, opened from file://
+    (the visit test_page_offline checks: canvases drawn, nothing fetched from outside)."""
+    _, pages = site
     name = next((f for f, p in pages.items() if p["views"]), None)
     assert name, "no page has a live 3D view"
-    view = OfflinePage(browser, (folder / "index.html").resolve().as_uri().rsplit("/", 1)[0] + "/")
-    try:
-        view.page.goto((folder / name).resolve().as_uri())
-        assert view.page.evaluate(JS_MATH_DONE), "MathJax did not load from file://"
-        shots = SCREENSHOTS / "file-url"
-        shots.mkdir(parents=True, exist_ok=True)
-        _check_canvases(view.page, pages[name]["views"], shots)
-        assert not view.outside, f"requests to the network: {view.outside}"
-        assert not view.errors, "console errors:\n" + "\n".join(view.errors)
-    finally:
-        view.close()
+    _raised(visited(name)["offline"])
 
 
 NO_WEBGL = """
@@ -490,3 +560,45 @@ def test_the_site_stays_within_60_mb(site):
     assert size <= SITE_BYTES, f"the site is {size / 1e6:.1f} MB; largest pages: " + ", ".join(
         f"{p['file']} {p['bytes'] / 1e6:.1f} MB" for p in biggest
     )
+
+
+# ---------------------------------------------------------------------------
+# every page against WCAG 2.1 AA, on the page the offline test loads
+# ---------------------------------------------------------------------------
+
+AUDITED = [*_order(), "index.html"]  # the pages named by a test of their own
+
+
+def _assert_accessible(name, outcome):
+    found, info, cut = _raised(outcome["audit"])
+    by_impact, _ = axe_audit.counts(found)
+    totals = dict(by_impact) | {"tab stops": info["tabStops"], "to the first slider": info["beforeSlider"]}
+    print(f"{name}: axe violations (nodes by impact), Tab stops:", json.dumps(totals))
+    violations = [
+        f"{name}: {v['id']} ({v['impact']}, {len(v['nodes'])} nodes: "
+        + "; ".join(n["target"] for n in v["nodes"][:3])
+        + f") {v['help']}"
+        for v in found
+        if v["impact"] in ("serious", "critical")
+    ]
+    problems = axe_audit.problems(name, info, cut, bool(info["sliders"] or info["views"]))
+    problems += [f"{name}: {e}" for e in outcome["uncaught"]]
+    assert not (violations or problems), "\n".join(
+        ["axe-core, serious or critical:", *violations, "the page's own checks:", *problems]
+    )
+
+
+@pytest.mark.parametrize("name", AUDITED)
+def test_page_meets_wcag_aa_offline(name, site, visited):
+    folder, _ = site
+    assert (folder / name).is_file(), f"{name} was not built"
+    _assert_accessible(name, visited(name))
+
+
+def test_every_other_page_meets_wcag_aa_offline(site, visited):
+    """Whatever other HTML page the folder holds is audited too."""
+    folder, pages = site
+    names = axe_audit.pages_of(folder)
+    assert "index.html" in names and len(names) >= len(pages)
+    for name in sorted(set(names) - set(AUDITED)):
+        _assert_accessible(name, visited(name))
