@@ -18,7 +18,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from geomlib import boundary_vertices, check, implicit_smoothing, laplacian
+from geomlib import boundary_vertices, check, enclosed_volume, implicit_smoothing, laplacian
 from geomlib.lessons.laplace import edge_lengths
 
 SEED = 20261128  # the checks' cases, drawn as one run of a class would draw them
@@ -1404,17 +1404,37 @@ def metrics_noisy_diagonal(V, V_clean, F):
     }
 
 
-@student("denoising_metrics", named="unsigned")
-def metrics_unsigned_volume(V, V_clean, F):
+@student("denoising_metrics", named="ratio vol / vol_clean")
+def metrics_volume_ratio(V, V_clean, F):
     d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
     cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
-    vol = np.abs(np.linalg.det(V[F])).sum() / 6  # a volume is positive
-    vol0 = np.abs(np.linalg.det(V_clean[F])).sum() / 6
     return {
         "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
         "normal_mean": np.degrees(np.arccos(cos)).mean(),
-        "volume_change": (vol - vol0) / vol0,
+        "volume_change": enclosed_volume(V, F) / enclosed_volume(V_clean, F),  # how much of the volume is left
     }
+
+
+@student("denoising_metrics", named="sign of the volume change is flipped")
+def metrics_volume_lost(V, V_clean, F):
+    diag = np.linalg.norm(np.ptp(V_clean, axis=0))
+    theta = np.arccos(np.clip(np.einsum("ij,ij->i", _unit_normals(V, F), _unit_normals(V_clean, F)), -1, 1))
+    vol0 = enclosed_volume(V_clean, F)
+    lost = (vol0 - enclosed_volume(V, F)) / abs(vol0)  # the share of the volume lost by smoothing
+    return {
+        "rms": np.linalg.norm(V - V_clean) / np.sqrt(len(V)) / diag,
+        "normal_mean": np.degrees(theta).mean(),
+        "volume_change": lost,
+    }
+
+
+@student("denoising_metrics")
+def metrics_handed_volume(V, V_clean, F):
+    diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    theta = np.degrees(np.arccos(np.clip(np.sum(_unit_normals(V, F) * _unit_normals(V_clean, F), axis=1), -1, 1)))
+    vol, vol0 = enclosed_volume(V, F), enclosed_volume(V_clean, F)
+    return {"rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / diag, "normal_mean": theta.mean(),
+            "volume_change": (vol - vol0) / abs(vol0)}  # fmt: skip
 
 
 # ============================================================================ 07 · denoising_experiment
@@ -1863,7 +1883,7 @@ def metrics_unrooted(V, V_clean, F):
 def metrics_over_new_volume(V, V_clean, F):
     diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
     n, n0 = _unit_normals(V, F), _unit_normals(V_clean, F)
-    vol, vol0 = (np.linalg.det(X[F]).sum() / 6 for X in (V, V_clean))
+    vol, vol0 = (enclosed_volume(X, F) for X in (V, V_clean))
     return {
         "rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / diag,
         "normal_mean": np.rad2deg(np.arccos(np.clip(np.sum(n * n0, axis=1), -1, 1))).mean(),
