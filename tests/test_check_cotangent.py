@@ -183,3 +183,106 @@ def test_mixed_areas_per_face_values_and_the_shortcut():
     result = check.mixed_areas(lambda V, F: __import__("geomlib").vertex_areas(V, F, area="mixed"))
     assert_diagnosed(result, "`vertex_areas`")
     assert not result.partial
+
+
+# ---------------------------------------------------------------- discrete_principal_curvatures(V, F, M, C, deficit)
+def learner_kappas(V, F, M, C, deficit, sign=-0.5, unit=True, per_area=True, clamp=np.maximum, order=1, absolute=False):
+    """kappa_1,2 from the signed H (area-weighted normals) and K = deficit / A, with the mistakes as switches."""
+    A = M.diagonal()
+    DX = (C @ V) / A[:, None]
+    cross = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    N = np.zeros_like(V)
+    for corner in F.T:
+        np.add.at(N, corner, cross)
+    if unit:
+        N /= np.linalg.norm(N, axis=1, keepdims=True)
+    H = sign * np.sum(DX * N, axis=1)
+    H = np.abs(H) if absolute else H
+    K = deficit / A if per_area else deficit
+    with np.errstate(invalid="ignore"):
+        root = np.sqrt(clamp(H * H - K, 0.0))
+    return (H + root, H - root)[::order]
+
+
+def learner_kappas_loop(V, F, M, C, deficit):
+    """Another right answer: dense matrices, normals summed in a loop over faces, the clamp by np.where."""
+    Minv = np.diag(1 / np.diag(M.toarray()))
+    Lx = Minv @ C.toarray() @ V
+    N = np.zeros((len(V), 3))
+    for i, j, k in F:
+        N[[i, j, k]] += np.cross(V[j] - V[i], V[k] - V[i])
+    H = np.array([-0.5 * Lx[v] @ N[v] / np.linalg.norm(N[v]) for v in range(len(V))])
+    K = deficit / np.diag(M.toarray())
+    d = H**2 - K
+    with np.errstate(invalid="ignore"):
+        s = np.sqrt(np.where(d < 0, 0.0, d))  # NaN < 0 is False: the boundary's NaN goes through
+    return [H + s, H - s]
+
+
+KAPPA_MISTAKES = {
+    "swapped": (lambda *a: learner_kappas(*a, order=-1), "kappa_1 and kappa_2 are swapped"),
+    "integrated K": (lambda *a: learner_kappas(*a, per_area=False), "not divided by the area"),
+    "no clamp": (lambda *a: learner_kappas(*a, clamp=lambda d, _: d), "is not clamped"),
+    "|H^2 - K|": (lambda *a: learner_kappas(*a, clamp=lambda d, _: np.abs(d)), "|H^2 - K| is used"),
+    "|H|": (lambda *a: learner_kappas(*a, absolute=True), "the sign of H is lost"),
+    "inward normals": (lambda *a: learner_kappas(*a, sign=0.5), "H has the wrong sign"),
+    "no 1/2": (lambda *a: learner_kappas(*a, sign=-1.0), "the factor 1/2 is missing"),
+    "raw normals": (lambda *a: learner_kappas(*a, unit=False), "the normals are not normalised"),
+    "boundary filled": (lambda *a: np.nan_to_num(learner_kappas(*a)), "have values at boundary vertices"),
+    "one array (n, 2)": (lambda *a: np.stack(learner_kappas(*a), axis=1), "not the pair (kappa_1, kappa_2)"),
+}
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("fn", [learner_kappas, learner_kappas_loop, lambda *a: np.stack(learner_kappas(*a))])
+def test_discrete_principal_curvatures_accept_correct_variants(fn, seed):
+    result = check.discrete_principal_curvatures(fn, seed=seed)
+    assert result.passed and "barycentric (M, C)" in result.message, result.message
+
+
+@pytest.mark.parametrize("name", KAPPA_MISTAKES)
+def test_discrete_principal_curvatures_diagnoses(name):
+    fn, phrase = KAPPA_MISTAKES[name]
+    result = check.discrete_principal_curvatures(fn, seed=7)
+    assert_diagnosed(result, phrase, "Reread section 5")
+    assert result.partial == (name != "one array (n, 2)"), result.message
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("entry", [e for e in catalogues.KAPPA_MISTAKES if e.build is not None], ids=repr)
+def test_every_wrong_pair_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
+    cases = catalogues.principal_cases(np.random.default_rng(seed))
+    result = check.discrete_principal_curvatures(replaying(cases, entry.build), seed=seed)
+    assert_diagnosed(result, entry.diagnosis, f"Cases seed {seed}.")
+    assert result.partial
+
+
+def test_the_principal_cases_clamp_split_and_bend_both_ways():
+    for seed in SEEDS:
+        cases = {c.label.split(" with")[0]: c for c in catalogues.principal_cases(np.random.default_rng(seed))}
+        ico, saddle, bump = (
+            cases["a jittered icosphere"],
+            cases["a saddle on a 4 x 4 grid"],
+            cases["a bump on a 4 x 4 grid"],
+        )
+        assert (ico.H**2 < ico.K).all()  # the clamp at every vertex
+        inside = ~saddle.boundary
+        assert (saddle.H[inside] < 0).any() and (saddle.H[inside] > 0).any() and (saddle.K[inside] < 0).all()
+        assert bump.boundary.any() and np.isnan(bump.kappas[:, bump.boundary]).all()
+
+
+def test_discrete_principal_curvatures_stub_and_the_shortcuts():
+    assert_diagnosed(check.discrete_principal_curvatures(stub), "not written yet")
+    from geomlib import discrete_principal_curvatures, principal_curvatures, vertex_normals
+
+    result = check.discrete_principal_curvatures(discrete_principal_curvatures)
+    assert_diagnosed(result, "`discrete_principal_curvatures`", "asks you to write")
+    assert not result.partial
+
+    def with_geomlib_normals(V, F, M, C, deficit):
+        N = vertex_normals(V, F)
+        return principal_curvatures(-0.5 * np.sum((C @ V) / M.diagonal()[:, None] * N, axis=1), deficit / M.diagonal())
+
+    result = check.discrete_principal_curvatures(with_geomlib_normals)
+    assert_diagnosed(result, "earns no points")
+    assert not result.partial

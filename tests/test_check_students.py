@@ -657,6 +657,103 @@ def mixed_halves_swapped(V, F):
     return A
 
 
+# ============================================================================ 03 · discrete_principal_curvatures
+
+
+@student("discrete_principal_curvatures")
+def principal_face_loop(V, F, M, C, deficit):
+    n = len(V)
+    normal = np.zeros((n, 3))
+    for a, b, c in F:
+        normal[[a, b, c]] += np.cross(V[b] - V[a], V[c] - V[a])
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    area = M.diagonal()
+    lap = (C @ V) / area[:, None]
+    k1, k2 = np.zeros(n), np.zeros(n)
+    for i in range(n):
+        H = -0.5 * lap[i].dot(normal[i])
+        K = deficit[i] / area[i]
+        disc = max(H * H - K, 0.0) if not np.isnan(K) else np.nan
+        k1[i], k2[i] = H + np.sqrt(disc), H - np.sqrt(disc)
+    return k1, k2
+
+
+@student("discrete_principal_curvatures")
+def principal_sparse_incidence(V, F, M, C, deficit):
+    m = len(F)
+    faces_at = sp.csr_matrix((np.ones(3 * m), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(len(V), m))
+    n_f = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n_v = faces_at @ n_f
+    n_v = n_v / np.sqrt((n_v**2).sum(axis=1, keepdims=True))
+    Minv = sp.diags(1.0 / M.diagonal())
+    H = -0.5 * ((Minv @ C @ V) * n_v).sum(axis=1)
+    K = Minv @ deficit
+    delta = np.clip(H**2 - K, 0, None)
+    return np.vstack([H + np.sqrt(delta), H - np.sqrt(delta)])
+
+
+@student("discrete_principal_curvatures", named="H is unsigned")
+def principal_norm_of_laplacian(V, F, M, C, deficit):
+    A = M.diagonal()
+    H = 0.5 * np.linalg.norm(C @ V, axis=1) / A  # the mean curvature normal's length
+    K = deficit / A
+    s = np.sqrt(np.maximum(H**2 - K, 0))
+    return H + s, H - s
+
+
+@student("discrete_principal_curvatures", named="is not clamped")
+def principal_no_clamp(V, F, M, C, deficit):
+    normals = np.zeros(V.shape)
+    for c in range(3):
+        e1 = V[F[:, (c + 1) % 3]] - V[F[:, c]]
+        e2 = V[F[:, (c + 2) % 3]] - V[F[:, c]]
+        np.add.at(normals, F[:, c], np.cross(e1, e2))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    H = -0.5 * np.einsum("ij,ij->i", sp.diags(1 / M.diagonal()) @ (C @ V), normals)
+    K = deficit / M.diagonal()
+    r = np.sqrt(H**2 - K)
+    return H + r, H - r
+
+
+@student("discrete_principal_curvatures", named="kappa_1 < kappa_2")
+def principal_swapped_and_integrated(V, F, M, C, deficit):
+    N = np.zeros((len(V), 3))
+    for tri in F:
+        i, j, k = tri
+        N[tri] += np.cross(V[j] - V[i], V[k] - V[i])
+    N = N / np.linalg.norm(N, axis=1)[:, None]
+    H = -0.5 * np.sum((C @ V) / M.diagonal()[:, None] * N, axis=1)
+    K = deficit  # the angle deficit is the Gaussian curvature
+    root = np.sqrt(np.maximum(H * H - K, 0))
+    return H - root, H + root
+
+
+@student("discrete_principal_curvatures", named="have values at boundary vertices")
+def principal_nan_to_num(V, F, M, C, deficit):
+    cr = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    nrm = np.zeros_like(V)
+    for c in range(3):
+        np.add.at(nrm, F[:, c], cr)
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    H = -0.5 * np.einsum("ij,ij->i", (C @ V) / M.diagonal()[:, None], nrm)
+    K = np.nan_to_num(deficit) / M.diagonal()  # the NaNs gave warnings
+    d = np.sqrt(np.maximum(H**2 - K, 0.0))
+    return H + d, H - d
+
+
+@student("discrete_principal_curvatures", named="with a sign: the part of M^-1 C x along the surface")
+def principal_meyer_magnitude(V, F, M, C, deficit):
+    # Meyer et al.: kappa_H = 1/2 |K(x_i)|, the mean curvature normal's length, its sign from the normal
+    K_vec = -(C @ V) / M.diagonal()[:, None]
+    n = np.zeros_like(V)
+    for corner in range(3):
+        np.add.at(n, F[:, corner], np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]))
+    H = 0.5 * np.linalg.norm(K_vec, axis=1) * np.sign(np.sum(K_vec * n, axis=1))
+    kG = deficit / M.diagonal()
+    sq = np.sqrt(np.maximum(H**2 - kG, 0))
+    return H + sq, H - sq
+
+
 # ============================================================================ 04 · eigenpairs
 
 

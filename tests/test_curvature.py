@@ -173,6 +173,20 @@ def test_discrete_principal_curvatures_of_a_saddle_have_opposite_signs():
     assert inside.any() and (k1[inside] > 0).all() and (k2[inside] < 0).all()
 
 
+def test_discrete_principal_curvatures_are_nan_at_a_vertex_of_no_area_without_a_warning():
+    import scipy.sparse as sp
+
+    s = surfaces.sphere(1.0, subdivisions=1)
+    M, C = laplacian(s.V, s.F)
+    V = np.vstack([s.V, [[5.0, 5.0, 5.0]]])  # in no triangle: M_ii = 0
+    M, C = sp.block_diag([M, sp.csr_matrix((1, 1))]), sp.block_diag([C, sp.csr_matrix((1, 1))])
+    deficit = np.append(gaussian_curvature(s.V, s.F, integrated=True), 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        k1, k2 = discrete_principal_curvatures(V, s.F, M, C, deficit)
+    assert np.isnan(k1[-1]) and np.isnan(k2[-1]) and np.isfinite(k1[:-1]).all()
+
+
 def test_discrete_principal_curvatures_refuse_bad_input():
     s = surfaces.sphere(1.0, subdivisions=1)
     M, C = laplacian(s.V, s.F)

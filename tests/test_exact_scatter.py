@@ -17,3 +17,4 @@ def test_each_panel_holds_its_points_and_the_diagonal():
         assert np.allclose(points.get_xdata(), exact) and np.allclose(points.get_ydata(), factor * exact + shift)
         assert np.allclose(diagonal.get_xdata(), diagonal.get_ydata())
     assert fig.axes[1].get_xlabel() == "exact K"
+    assert exact_scatter_figure([(exact, exact, "your κ₁")]).axes[0].get_xlabel() == "exact κ₁"

@@ -356,5 +356,6 @@ def discrete_principal_curvatures(V, F, M, C, deficit):
     if (A < 0).any():
         raise MeshError(f"M has negative vertex areas at vertices {format_indices(np.flatnonzero(A < 0))}")
     H = signed_mean_curvature(V, F, M, C)  # NaN on the boundary and where M_ii = 0
-    K = deficit / np.where(A > 0, A, np.nan)  # pointwise: the deficit per unit area
+    with np.errstate(divide="ignore", invalid="ignore"):  # where M_ii = 0, H is NaN and so are the kappas
+        K = deficit / A  # pointwise: the deficit per unit area
     return principal_curvatures(H, K)

@@ -1,23 +1,37 @@
-"""Checks of the exercises of notebook 03: the cotangent matrix from edge lengths alone, and the mixed areas.
+"""Checks of the exercises of notebook 03: the cotangent matrix from edge lengths alone, the mixed areas, and the
+discrete principal curvatures.
 
 ``cotangent_matrix`` hands the learner's function the per-face edge lengths ``l`` (m, 3) and ``F`` of an
 irregular tetrahedron (closed, no right angle), an irregular bipyramid (closed, obtuse triangles) and a
 jittered 4 x 4 grid (open: boundary edges with one triangle), placed anew every run; its typical mistakes are
 rebuilt from the right per-corner cotangents and Heron's areas. ``mixed_areas`` names its mistakes from
-``check.area_mistakes``, in the words every area check uses.
+``check.area_mistakes``, in the words every area check uses. ``discrete_principal_curvatures`` hands in the
+cotangent pair and the angle deficits (NaN on the boundary) of a jittered icosphere (the discrete H^2 < K at every
+vertex: the clamp), a bump and a saddle on 4 x 4 grids (open; H of both signs on the saddle) and a bipyramid whose
+M is barycentric (M is read, not rebuilt); its H mistakes are notebook 01's (``uniform.H_MISTAKES``).
 """
 
 import numpy as np
 
+from ...lessons.curvature import discrete_principal_curvatures as geomlib_principal
+from ...lessons.curvature import gaussian_curvature
 from ...lessons.laplace import cotangent_matrix as geomlib_cotangent_matrix
-from ...lessons.laplace import edge_lengths
+from ...lessons.laplace import edge_lengths, laplacian
 from ...mesh.topology import boundary_edges
 from .area_mistakes import AREA_MISTAKES, RIGHT_AREAS
 from .catalogue import Case, Wrong, judge, mesh_cases, run, vector
-from .meshes import irregular_bipyramid, irregular_tetrahedron, jittered_grid_4x4, obtuse_triangle
+from .meshes import (
+    bump_4x4,
+    irregular_bipyramid,
+    irregular_tetrahedron,
+    jittered_grid_4x4,
+    jittered_icosphere,
+    obtuse_triangle,
+)
 from .result import Mistake, case_rng, exercise
+from .uniform import H_MISTAKES, mean_facts
 
-__all__ = ["cotangent_matrix", "mixed_areas"]
+__all__ = ["cotangent_matrix", "mixed_areas", "discrete_principal_curvatures"]
 
 NEXT, PREV = [1, 2, 0], [2, 0, 1]  # the corners j, k that follow corner i
 _RULE = "corner i of each face adds 1/2 cot(theta_i) to C_jk and C_kj, (j, k) the edge opposite it"
@@ -168,4 +182,83 @@ def mixed_areas(fn):
     cases = areas_cases(case_rng())
     answers = run(fn, cases, _per_vertex)
     judge(AREA_MISTAKES["mixed"], cases, answers, right=RIGHT_AREAS["mixed"])
+    return [c.label for c in cases]
+
+
+def _kappas(H, K, root=lambda d: np.sqrt(np.maximum(d, 0.0))):
+    """(2, n): kappa_1 = H + root(H^2 - K) above kappa_2 = H - root(H^2 - K); NaN stays NaN."""
+    with np.errstate(invalid="ignore"):
+        r = root(H * H - K)
+    return np.stack([H + r, H - r])
+
+
+def principal_cases(rng):
+    meshes = (("a jittered icosphere", jittered_icosphere()), ("a bump on a 4 x 4 grid", bump_4x4()))
+    meshes += (("a saddle on a 4 x 4 grid", jittered_grid_4x4()), ("an irregular bipyramid", irregular_bipyramid()))
+    cases = []
+    for c, area in zip(mesh_cases(meshes, rng), ("mixed", "mixed", "mixed", "barycentric")):
+        M, C = laplacian(c.V, c.F, area=area)
+        deficit = gaussian_curvature(c.V, c.F, integrated=True)  # NaN on the boundary
+        case = Case(f"{c.label} with the {area} (M, C)", V=c.V, F=c.F, M=M, C=C, deficit=deficit)
+        right = np.stack(geomlib_principal(c.V, c.F, M, C, deficit))
+        case = case.but(**mean_facts(c.V, c.F, M, C), K=deficit / M.diagonal(), kappas=right)
+        cases.append(case.but(where=np.isfinite(right), interior=np.isfinite(right)))
+    return cases
+
+
+_RULE_K = "kappa_1,2 = H +- sqrt(max(H^2 - K, 0)), H_i = -1/2 <(M^-1 C x)_i, n_i>, K_i = deficit_i / M_ii"
+_CLAMP = "clamp where the discrete H^2 < K: sqrt(max(H^2 - K, 0)), so that kappa_1 = kappa_2 = H there"
+# fmt: off
+KAPPA_MISTAKES = [
+    Wrong("kappa_1 and kappa_2 are swapped: kappa_1 < kappa_2", "kappa_1 = H + sqrt(max(H^2 - K, 0)) is the larger", build=lambda c: c.kappas[::-1]),
+    Wrong("K is the deficit itself, not divided by the area (integrated, not pointwise)", "the deficit is an angle (radians); K_i = deficit_i / M_ii is per unit area", build=lambda c: _kappas(c.H, c.deficit)),
+    Wrong("H^2 - K is not clamped: its square root is NaN where the discrete H^2 < K", _CLAMP, build=lambda c: _kappas(c.H, c.K, np.sqrt)),
+    Wrong("|H^2 - K| is used where the discrete H^2 < K, not the clamp to 0", _CLAMP, build=lambda c: _kappas(c.H, c.K, lambda d: np.sqrt(np.abs(d)))),
+    Wrong("the square root is missing: H +- (H^2 - K)", _RULE_K, build=lambda c: _kappas(c.H, c.K, lambda d: np.maximum(d, 0.0))),
+    Wrong("the sign of H is lost: |H| drops the side the surface bends to", "H_i = -1/2 <(M^-1 C x)_i, n_i> is negative where the surface bends away from n_i", build=lambda c: _kappas(np.abs(c.H), c.K)),
+    Wrong("H is |M^-1 C x|: unsigned and without the 1/2", "H_i = -1/2 <(M^-1 C x)_i, n_i>", build=lambda c: _kappas(np.linalg.norm(c.DX, axis=1), c.K)),
+    Wrong("H is 1/2 |M^-1 C x| with a sign: the part of M^-1 C x along the surface is counted", "project onto the normal: H_i = -1/2 <(M^-1 C x)_i, n_i>", build=lambda c: _kappas(-0.5 * np.linalg.norm(c.DX, axis=1) * np.sign(np.einsum("ij,ij->i", c.DX, c.N)), c.K)),
+    *(Wrong(h.diagnosis, h.hint, build=lambda c, h=h: _kappas(h.build(c), c.K)) for h in H_MISTAKES if h.build is not None),
+    Wrong("kappa_1 < kappa_2 at a vertex of {label}", "kappa_1 = H + sqrt(...) >= kappa_2 = H - sqrt(...)", when=lambda k, right, c: (k[0][c.where[0]] < k[1][c.where[0]]).any()),
+    Wrong("kappa_1, kappa_2 differ from H +- sqrt(max(H^2 - K, 0)) at interior vertices of {label}", _RULE_K, typical=False),
+]
+# fmt: on
+KAPPA_BOUNDARY = [
+    Wrong(
+        "kappa_1, kappa_2 have values at boundary vertices, where the deficit (and so K) is NaN",
+        "let the NaN through: np.maximum and np.sqrt keep it (np.fmax, np.nan_to_num and a mask on H^2 < K do not)",
+    ),
+]
+
+
+def _pair(out, n):
+    """(2, n) float array from the pair (kappa_1, kappa_2) the function returned."""
+    if not isinstance(out, (tuple, list, np.ndarray)) or len(out) != 2:
+        raise Mistake(
+            f"the function returned {type(out).__name__} of {np.shape(out)}, not the pair (kappa_1, kappa_2)",
+            "end with `return k1, k2`, each of shape (n,)",
+            typical=False,
+        )
+    return np.stack([vector(k, n, f"the function, as kappa_{i + 1},") for i, k in enumerate(out)])
+
+
+@exercise(
+    "discrete_principal_curvatures",
+    reread="section 5 · Principal curvatures",
+    forbid=(
+        "lessons.curvature.discrete_principal_curvatures",
+        "lessons.curvature.principal_curvatures",
+        "lessons.curvature.signed_mean_curvature",
+        "lessons.curvature.mean_curvature",
+        "mesh.geometry.vertex_normals",
+        "mesh.geometry.face_normals",
+    ),
+    own=("lessons.curvature.discrete_principal_curvatures", "lessons.curvature.principal_curvatures"),
+)
+def discrete_principal_curvatures(fn):
+    """Check ``fn(V, F, M, C, deficit) -> (kappa_1, kappa_2)``: H +- sqrt(max(H^2 - K, 0)), NaN on the boundary."""
+    cases = principal_cases(case_rng())
+    answers = run(fn, cases, _pair)
+    judge(KAPPA_MISTAKES, cases, answers, right=lambda c: c.kappas)
+    judge(KAPPA_BOUNDARY, [c.but(where=~c.interior) for c in cases], answers, right=lambda c: c.kappas)
     return [c.label for c in cases]

@@ -131,7 +131,7 @@ def _normal_sums(V, F, per_face):
     return np.stack([np.bincount(F.ravel(), np.repeat(per_face[:, k], 3), minlength=len(V)) for k in range(3)], 1)
 
 
-def _mean_facts(V, F, M, C):
+def mean_facts(V, F, M, C):
     """The right H and what the mistakes are made of: Delta x, the normal sums, the boundary."""
     A = M.diagonal()
     N2, N1 = _normal_sums(V, F, face_cross(V, F)), _normal_sums(V, F, face_normals(V, F))
@@ -149,7 +149,7 @@ def mean_cases(rng):
         cotan = k == 3
         M, C = laplacian(c.V, c.F) if cotan else laplacian(c.V, c.F, weights="uniform")
         label = c.label + (" with the cotangent (M, C)" if cotan else "")
-        cases.append(Case(label, V=c.V, F=c.F, M=M, C=C).but(**_mean_facts(c.V, c.F, M, C)))
+        cases.append(Case(label, V=c.V, F=c.F, M=M, C=C).but(**mean_facts(c.V, c.F, M, C)))
     return cases
 
 
