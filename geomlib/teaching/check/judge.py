@@ -20,6 +20,7 @@ does in the kernel.
 """
 
 import ast
+import atexit
 import os
 import select
 import signal
@@ -51,6 +52,7 @@ def verdicts(nb, solution=None, timeout=1800):
             stderr=log,
             env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
         )
+        atexit.register(_end, judge)
     try:
         send(judge.stdin.fileno(), {"notebook": nb, "solution": solution})
         found = receive(judge.stdout.fileno()) if select.select([judge.stdout], [], [], timeout)[0] else None
@@ -62,6 +64,16 @@ def verdicts(nb, solution=None, timeout=1800):
         _JUDGE["log"].seek(0)
         raise RuntimeError(f"the grading judge failed: {_JUDGE['log'].read().decode(errors='replace')[-2000:]}")
     return found
+
+
+def _end(judge):
+    """End the judge process as the grading run ends (its stdin closed, it exits)."""
+    judge.stdin.close()
+    try:
+        judge.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        judge.kill()
+        judge.wait()
 
 
 class Zygote:
