@@ -392,6 +392,27 @@ def test_the_judge_finds_the_earlier_routine_an_answer_builds_on_in_the_sandbox(
     assert found["mixed_areas"]["check"][0]
 
 
+@pytest.mark.slow
+def test_each_exercise_is_judged_in_a_fresh_process_of_its_own():
+    # the sandboxes of a notebook are forked from one process holding its imports: what one
+    # exercise's calls leave behind (here a count on the numpy module) must not reach the next
+    nb = nbformat.read(ROOT / "notebooks" / "05_explicit_smoothing.ipynb", as_version=4)
+    for cell in nb.cells:
+        grade_id = cell.metadata.get("nbgrader", {}).get("grade_id", "")
+        if grade_id == "lam_max":
+            cell.source = cell.source.replace("    return lam", "    np.lam_max_calls = 1\n    return lam")
+        if grade_id == "smoothing_loop":  # wrong, should it see a call of my_lam_max made before its own first
+            cell.source = cell.source.replace(
+                "    ### BEGIN SOLUTION\n",
+                "    ### BEGIN SOLUTION\n"
+                "    if getattr(np, 'lam_max_calls', 0) and not getattr(np, 'smooth_called', False):\n"
+                "        return V + 1.0\n"
+                "    np.smooth_called = True\n",
+            )
+    found = judge.verdicts(nb)
+    assert [found[e]["check"][0] for e in ("lam_max", "smoothing_loop")] == [True, True], found
+
+
 def hand_in(course, student, notebooks, edit):
     """The released notebooks ``notebooks`` as ``student`` hands them in, each solution cell through ``edit``."""
     out = course / "submitted" / student / ASSIGNMENT

@@ -56,6 +56,11 @@ page shows the diagnosis. Each exercise has two grade cells:
 ``use`` calls ``check.NAME.evaluate(fn)``, which never raises, so the cells after
 an exercise run on geomlib's own function in every mode.
 
+While graded, a check decides each function once: the first verdict on a function (its
+grade cell's) is the one its partial-credit cell, ``reveal`` and ``use`` read, as the
+grading judge derives partial credit from its one verdict per exercise; a reader's run
+draws fresh cases at every call.
+
 Ground rules
 ------------
 The ground rules are an allow-list (``fence``): an answer may use numpy and scipy
@@ -394,8 +399,18 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
     rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools, yours)
 
     def wrap(body):
+        decided = {}  # while graded: id(fn) -> (fn, its CheckResult), the first verdict on each function
+
         def evaluate(fn, seed=None):
-            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises."""
+            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises.
+            While graded, a function is decided once (module docstring)."""
+            if seed is not None or not graded():
+                return decide(fn, seed)
+            if id(fn) not in decided or decided[id(fn)][0] is not fn:
+                decided[id(fn)] = fn, decide(fn, seed)
+            return decided[id(fn)][1]
+
+        def decide(fn, seed):
             try:
                 _RULES[0] = rules
                 _SEED.update(asked=seed, used=None)
