@@ -5,8 +5,8 @@ in order in one kernel, so its cells must not be spread over workers. Set here r
 ``--dist loadfile`` in pyproject's addopts, so that a pytest without xdist (an environment with nbval
 only) still reads the configuration.
 
-The files are handed to the workers longest first (:data:`FILE_SECONDS`), so that the run does not end
-with one worker grading a class while the other has nothing left to do.
+The files are handed to the workers longest first (:data:`FILE_SECONDS`), each when a worker is free,
+so that the run does not end with one worker grading a class while the other has nothing left to do.
 """
 
 import pytest
@@ -50,6 +50,14 @@ def pytest_xdist_make_scheduler(config, log):
     from xdist.scheduler import LoadFileScheduling
 
     class LongestFileFirst(LoadFileScheduling):
+        def _reschedule(self, node):
+            # A worker starts a test once it knows the next one, so xdist hands it the next file while
+            # two tests of its file are left, committing that file to a worker still busy for minutes
+            # (a file's last tests grade a class or run the guide's trial). With one test left the
+            # worker is waiting for exactly this: the next file goes to the worker that is free.
+            if node.shutting_down or not self.workqueue or self._pending_of(self.assigned_work[node]) <= 1:
+                super()._reschedule(node)
+
         def _assign_work_unit(self, node):
             # the costliest file still waiting goes next; among equals, xdist's order (max keeps the first)
             scope = max(self.workqueue, key=lambda file: FILE_SECONDS.get(file, 0))

@@ -16,16 +16,18 @@ spec.loader.exec_module(checkout)
 
 
 class Worker:
-    """What the scheduler calls on one of xdist's workers: the test indexes it is sent."""
+    """What the scheduler calls on one of xdist's workers: the tests it is sent, in a queue; and how
+    many were still waiting in its queue each time it was sent a file."""
 
     shutting_down = False
 
     def __init__(self, name):
         self.gateway = SimpleNamespace(id=name)
-        self.sent = []
+        self.queue, self.waiting_when_sent = [], []
 
     def send_runtest_some(self, indexes):
-        self.sent.append(list(indexes))
+        self.waiting_when_sent.append(len(self.queue))
+        self.queue += indexes
 
     def shutdown(self):
         self.shutting_down = True
@@ -55,16 +57,20 @@ def test_the_longest_files_go_first_and_the_rest_in_xdists_order():
         sched.add_node_collection(w, collection)
     sched.schedule()
     order, ran = [], []
-    while any(w.sent for w in workers):
-        for w in workers:  # each worker runs the file it was sent, test by test
-            if w.sent:
-                indexes = w.sent.pop(0)
-                order.append(collection[indexes[0]].split("::")[0])
-                for i in indexes:
-                    ran.append(i)
-                    sched.mark_test_complete(w, i)
+    # as xdist's worker does, a worker runs a test once it knows the next one (or that none will come)
+    while any(len(w.queue) >= 2 or (w.queue and w.shutting_down) for w in workers):
+        for w in workers:
+            if len(w.queue) >= 2 or (w.queue and w.shutting_down):
+                i = w.queue.pop(0)
+                file = collection[i].split("::")[0]
+                if file not in order:
+                    order.append(file)
+                ran.append(i)
+                sched.mark_test_complete(w, i)
     assert order == [longer, long, "tests/many.py", "tests/some.py", "tests/few.py"]
     assert sorted(ran) == list(range(len(collection))) and sched.tests_finished
+    # a file is handed out when its worker has at most the one test waiting that it cannot start alone
+    assert all(waiting <= 1 for w in workers for waiting in w.waiting_when_sent), [w.waiting_when_sent for w in workers]
 
 
 def test_other_distributions_keep_xdists_scheduler():
