@@ -1454,29 +1454,80 @@ def metrics_handed_volume(V, V_clean, F):
 # ============================================================================ 07 · denoising_experiment
 
 
+def _noisy(V, sigma, seed):
+    return V + sigma * _diag(V) * np.random.default_rng(seed).standard_normal(V.shape)
+
+
+def _E(P, V):
+    return np.sqrt(np.mean(np.sum((P - V) ** 2, axis=1))) / _diag(V)
+
+
 @student("denoising_experiment")
-def experiment(V_clean, F, sigma, tau, iterations, seed):
-    d = _diag(V_clean)
-    W = V_clean + sigma * d * np.random.default_rng(seed).standard_normal(V_clean.shape)
-    P = implicit_smoothing(W, F, tau, iterations)
-    return np.sqrt(np.mean(np.sum((P - V_clean) ** 2, axis=1))) / d
+def experiment(V_clean, F, sigma, tau, iterations, seeds):
+    errors = []
+    for s in seeds:
+        P = implicit_smoothing(_noisy(V_clean, sigma, s), F, tau, iterations)
+        errors.append(_E(P, V_clean))
+    return np.mean(errors), np.std(errors, ddof=1)
+
+
+@student("denoising_experiment")
+def experiment_statistics(V_clean, F, sigma, tau, iterations, seeds):
+    import statistics
+
+    Es = [float(_E(implicit_smoothing(_noisy(V_clean, sigma, seed), F, tau, iterations), V_clean)) for seed in seeds]
+    return statistics.mean(Es), statistics.stdev(Es)  # stdev: the sample one, n - 1
+
+
+@student("denoising_experiment", named="population one (ddof = 0)")
+def experiment_population_std(V_clean, F, sigma, tau, iterations, seeds):
+    E = np.array([_E(implicit_smoothing(_noisy(V_clean, sigma, s), F, tau, iterations), V_clean) for s in seeds])
+    return E.mean(), E.std()
+
+
+@student("denoising_experiment", named="same seed made every draw")
+def experiment_one_seed(V_clean, F, sigma, tau, iterations, seeds):
+    W = _noisy(V_clean, sigma, seeds[0])
+    E = [_E(implicit_smoothing(W, F, tau, iterations), V_clean) for _ in seeds]  # the same noise each time
+    return np.mean(E), np.std(E, ddof=1)
+
+
+@student("denoising_experiment", named="standard deviation is that of the noisy meshes")
+def experiment_spread_of_noise(V_clean, F, sigma, tau, iterations, seeds):
+    E, E0 = [], []
+    for seed in seeds:
+        W = _noisy(V_clean, sigma, seed)
+        E0.append(_E(W, V_clean))
+        E.append(_E(implicit_smoothing(W, F, tau, iterations), V_clean))
+    return np.mean(E), np.std(E0, ddof=1)
+
+
+@student("denoising_experiment", named="seeds are ignored")
+def experiment_counted_seeds(V_clean, F, sigma, tau, iterations, seeds):
+    E = [_E(implicit_smoothing(_noisy(V_clean, sigma, k), F, tau, iterations), V_clean) for k in range(len(seeds))]
+    return np.mean(E), np.std(E, ddof=1)
 
 
 @student("denoising_experiment", named="one iteration short")
-def experiment_short(V_clean, F, sigma, tau, iterations, seed):
-    rng = np.random.default_rng(seed)
-    d = _diag(V_clean)
-    noisy = V_clean + rng.standard_normal(V_clean.shape) * sigma * d
-    smooth = implicit_smoothing(noisy, F, tau, max(iterations - 1, 0))  # "iterations must be at least 0"
-    return np.sqrt(((smooth - V_clean) ** 2).sum(axis=1).mean()) / d
+def experiment_short(V_clean, F, sigma, tau, iterations, seeds):
+    E = []
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        noisy = V_clean + rng.standard_normal(V_clean.shape) * sigma * _diag(V_clean)
+        smooth = implicit_smoothing(noisy, F, tau, max(iterations - 1, 0))  # "iterations must be at least 0"
+        E.append(np.sqrt(((smooth - V_clean) ** 2).sum(axis=1).mean()) / _diag(V_clean))
+    return sum(E) / len(E), np.std(E, ddof=1)
 
 
 @student("denoising_experiment", named="measured against the noisy mesh")
-def experiment_against_noisy(V_clean, F, sigma, tau, iterations, seed):
-    d = _diag(V_clean)
-    W = V_clean + sigma * d * np.random.default_rng(seed).standard_normal(V_clean.shape)
-    P = implicit_smoothing(W, F, tau, iterations)
-    return np.sqrt(np.mean(np.sum((P - W) ** 2, axis=1))) / d
+def experiment_against_noisy(V_clean, F, sigma, tau, iterations, seeds):
+    E = []
+    for seed in seeds:
+        W = _noisy(V_clean, sigma, seed)
+        E.append(
+            np.sqrt(np.mean(np.sum((implicit_smoothing(W, F, tau, iterations) - W) ** 2, axis=1))) / _diag(V_clean)
+        )
+    return np.mean(E), np.std(E, ddof=1)
 
 
 # ============================================================================ 07 · denoising_sweep
@@ -1906,11 +1957,12 @@ def metrics_over_new_volume(V, V_clean, F):
 
 
 @student("denoising_experiment", named="the error is absolute")
-def experiment_absolute(V_clean, F, sigma, tau, iterations, seed):
-    rng = np.random.default_rng(seed)
-    W = V_clean + sigma * _diag(V_clean) * rng.standard_normal(V_clean.shape)
-    P = implicit_smoothing(W, F, tau, iterations)
-    return float(np.sqrt(np.mean(np.linalg.norm(P - V_clean, axis=1) ** 2)))
+def experiment_absolute(V_clean, F, sigma, tau, iterations, seeds):
+    E = []
+    for seed in seeds:
+        P = implicit_smoothing(_noisy(V_clean, sigma, seed), F, tau, iterations)
+        E.append(float(np.sqrt(np.mean(np.linalg.norm(P - V_clean, axis=1) ** 2))))
+    return np.mean(E), np.std(E, ddof=1)
 
 
 @student("denoising_sweep", named="N_best is one too many")
