@@ -377,6 +377,22 @@ def test_the_judge_refuses_lam_max_from_geomlibs_largest_eigenpair():
 
 
 @pytest.mark.slow
+def test_the_judge_finds_the_earlier_routine_an_answer_builds_on_in_the_sandbox():
+    """03's principal curvatures call the student's section-1 C: the judge's check asks it there and names it."""
+    nb = nbformat.read(ROOT / "notebooks" / "03_cotangent_laplace.ipynb", as_version=4)
+    for cell in nb.cells:
+        if cell.metadata.get("nbgrader", {}).get("grade_id") == "cotangent_matrix":
+            cell.source = cell.source.replace("def my_cotangent_matrix", "def right_C") + (
+                "\n\ndef my_cotangent_matrix(l, F):\n    return 2 * right_C(l, F)\n"
+            )
+    found = judge.verdicts(nb)
+    assert not found["cotangent_matrix"]["check"][0]
+    passed, message = found["discrete_principal_curvatures"]["check"]
+    assert not passed and "your my_cotangent_matrix (section 1) returns a wrong C" in message, message
+    assert found["mixed_areas"]["check"][0]
+
+
+@pytest.mark.slow
 def test_each_exercise_is_judged_in_a_fresh_process_of_its_own():
     # the sandboxes of a notebook are forked from one process holding its imports: what one
     # exercise's calls leave behind (here a count on the numpy module) must not reach the next

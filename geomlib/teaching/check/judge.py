@@ -229,6 +229,10 @@ class Remote:
     def __init__(self, box, name):
         self.box, self.__name__ = box, name
 
+    def beside(self, name):
+        """The student's function ``name`` of the same notebook, called in the same sandbox (``result.earlier``)."""
+        return Remote(self.box, name)
+
     def __call__(self, *args):
         if self.box.refusal is not None:
             raise self.box.refusal
