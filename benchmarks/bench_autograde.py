@@ -16,8 +16,8 @@ the machine's load moves every figure alike:
 
 Prints seconds per student and the ratio serial / floor, and the same in processor seconds
 (this process's and its ended children's: kernels, nbgrader, the judge), which a busy machine
-moves less than the wall clock. Goal: at most 2x (2.9x before the
-grading run left out the stills and lesson work no grade cell needs).
+moves less than the wall clock. Goal: at most 2x (2.9x when issue 37 was filed, without
+the judge; benchmarks/README.md has the figures since).
 """
 
 import argparse
