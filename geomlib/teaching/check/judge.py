@@ -232,8 +232,8 @@ def judge_notebook(nb, solution=None):
         partial = credit(result)
         found[exercise] = {
             "passed": result.passed,
-            "check": [result.passed, f"{result.name}: {result.message}"],
-            "partial_credit": [partial.passed, f"{partial.name}: {partial.message}"],
+            "check": [result.passed, result.said],
+            "partial_credit": [partial.passed, partial.said],
             "copies": flags,
         }
     return found
