@@ -33,6 +33,9 @@ SHORTCUTS = {
     "mean_curvature": lambda V, F, M, C: geomlib.mean_curvature(V, F, "uniform", signed=True, boundary="nan"),
     "cotangent_matrix": lambda l, F: intrinsic_cotangent_matrix(l, F),
     "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
+    "discrete_principal_curvatures": lambda V, F, deficit: geomlib.lessons.curvature.mixed_principal_curvatures(
+        V, F, deficit
+    ),
     "spectral_reconstruction": lambda V, F, ks, solve: spectral.spectral_reconstructions(V, F, ks, solve),
     "eigenpairs": lambda M, C, k: spectral.eigenpairs(M, C, k),
     "lam_max": lambda M, C: eigen.largest_eigenvalue(

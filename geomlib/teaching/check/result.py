@@ -56,6 +56,11 @@ page shows the diagnosis. Each exercise has two grade cells:
 ``use`` calls ``check.NAME.evaluate(fn)``, which never raises, so the cells after
 an exercise run on geomlib's own function in every mode.
 
+While graded, a check decides each function once: the first verdict on a function (its
+grade cell's) is the one its partial-credit cell, ``reveal`` and ``use`` read, as the
+grading judge derives partial credit from its one verdict per exercise; a reader's run
+draws fresh cases at every call.
+
 Ground rules
 ------------
 The ground rules are an allow-list (``fence``): an answer may use numpy and scipy
@@ -114,6 +119,7 @@ __all__ = [
     "close",
     "use",
     "reveal",
+    "earlier",
 ]
 
 
@@ -209,15 +215,17 @@ class Refused(Exception):
 class _Rules:
     """The ground rules of one exercise: an allow-list (the module docstring of ``fence``)."""
 
-    def __init__(self, forbid, own, allow=(), tools=("numpy", "scipy")):
+    def __init__(self, forbid, own, allow=(), tools=("numpy", "scipy"), yours=()):
         self.forbid, self.own, self.allow, self.tools = tuple(forbid), tuple(own), tuple(allow), tuple(tools)
+        self.yours = tuple(yours)
         self.fence = Fence(self.allow)
 
     def sentence(self):
         tools = list(self.tools)
         if self.allow:
             tools[-1:] = [tools[-1], "geomlib's " + _listed([f"`{_public(d)}`" for d in self.allow])]
-        return f"Ground rules: {_listed(tools)} only: no other geomlib routine, geometry library or copied code."
+        listed = _listed(tools) + (", and your own " + _listed([f"`{n}`" for n in self.yours]) if self.yours else "")
+        return f"Ground rules: {listed} only: no other geomlib routine, geometry library or copied code."
 
     def refusal(self, name, why=""):
         if why:
@@ -385,23 +393,34 @@ def _seed_said():
     return "" if _SEED["used"] is None else f" Cases seed {_SEED['used']}."
 
 
-def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy")):
+def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy"), yours=()):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
 
     The ground rules are an allow-list: the answer may use ``tools`` and the geomlib
     routines ``allow`` names (dotted names inside geomlib); any other geomlib routine or a
     geometry library is refused. ``forbid``: the routines that would compute the answer,
     named in the rules' sentence; ``own``: those that are the exercise's own routine,
-    revealed by ``reveal`` (default: the first of ``forbid``).
+    revealed by ``reveal`` (default: the first of ``forbid``); ``yours``: the names of the
+    learner's routines of earlier exercises the answer builds on (``earlier`` looks them up).
     """
     overlap = set(forbid) & set(allow)
     if overlap:
         raise ValueError(f"exercise {name}: {sorted(overlap)} both forbidden and allowed")
-    rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools)
+    rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools, yours)
 
     def wrap(body):
+        decided = {}  # while graded: id(fn) -> (fn, its CheckResult), the first verdict on each function
+
         def evaluate(fn, seed=None):
-            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises."""
+            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises.
+            While graded, a function is decided once (module docstring)."""
+            if seed is not None or not graded():
+                return decide(fn, seed)
+            if id(fn) not in decided or decided[id(fn)][0] is not fn:
+                decided[id(fn)] = fn, decide(fn, seed)
+            return decided[id(fn)][1]
+
+        def decide(fn, seed):
             try:
                 _RULES[0] = rules
                 _SEED.update(asked=seed, used=None)
@@ -436,10 +455,29 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
 
         check.exercise, check.reread = name, reread
         check.forbid, check.own, check.allow, check.rules = rules.forbid, rules.own, rules.allow, rules.sentence()
+        check.yours = rules.yours
         check.evaluate, check.partial_credit = evaluate, partial_credit
         return check
 
     return wrap
+
+
+def earlier(fn, name, *args):
+    """What the learner's routine ``name`` of an earlier exercise returns on ``args``, or None where there is
+    none, it is not written or it raises.
+
+    It is looked up where ``fn`` was written: the notebook's namespace (``fn.__globals__``) in
+    the kernel, the grading sandbox (``fn.beside(name)``: ``judge.Remote``) under nbgrader. A
+    check whose answer calls the learner's earlier routines asks them first, to say which
+    exercise to fix rather than blame the new one.
+    """
+    other = fn.beside(name) if hasattr(fn, "beside") else getattr(fn, "__globals__", {}).get(name)
+    if not callable(other):
+        return None
+    try:
+        return call(other, *args)
+    except (Mistake, _NotWritten):
+        return None
 
 
 def credit(result):
