@@ -488,7 +488,7 @@ def test_autograde_gives_the_honest_student_full_points_and_the_mistaken_one_few
     assert got["mistaken"]["01"] == (got["honest"]["01"][0] - wrong, got["honest"]["01"][1])
     assert got["mistaken"]["03"][0] == 0  # not handed in
     said = grade_cell_outputs(course, "mistaken", "01", "uniform_laplacian")
-    assert "the sign of C is flipped" in said[0] and "earned: what is wrong is a typical mistake" in said[1]
+    assert "the sign of C is flipped" in said[0] and "earned. what is wrong is a typical mistake" in said[1]
     assert all(
         "decided by the grading judge" in text for text in grade_cell_outputs(course, "honest", "03", "mixed_areas")
     )

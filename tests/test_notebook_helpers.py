@@ -190,9 +190,9 @@ def test_partial_credit_for_a_mistake_the_check_names(monkeypatch):
     named = _check_double.partial_credit(lambda x: x)  # "nothing was doubled"
     assert named.passed and named.name == "double, partial credit"
     for wrong, reason in (
-        (lambda x: 3 * x, "not earned: the check cannot name what is wrong"),  # only the catch-all fits
-        (lambda x: x[:2], "not earned: the check cannot name what is wrong"),  # a wrong shape
-        (lambda x: 1 / 0, "not earned: the check cannot name what is wrong"),  # an exception
+        (lambda x: 3 * x, "not earned. the check cannot name what is wrong"),  # only the catch-all fits
+        (lambda x: x[:2], "not earned. the check cannot name what is wrong"),  # a wrong shape
+        (lambda x: 1 / 0, "not earned. the check cannot name what is wrong"),  # an exception
         (_stub, "not written yet"),
     ):
         with pytest.raises(CheckFailed, match=f"^double, partial credit: {reason}"):

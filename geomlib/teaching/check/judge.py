@@ -344,8 +344,8 @@ def judge_notebook(nb, solution=None):
             partial = credit(result)
             found[exercise] = {
                 "passed": result.passed,
-                "check": [result.passed, f"{result.name}: {result.message}"],
-                "partial_credit": [partial.passed, f"{partial.name}: {partial.message}"],
+                "check": [result.passed, result.said],
+                "partial_credit": [partial.passed, partial.said],
                 "copies": flags,
             }
     finally:

@@ -164,25 +164,35 @@ class CheckResult:
     message : str    what was checked (passed) or the diagnosis, hint and what to reread
     written : bool   False for a stub (the function raises NotImplementedError)
     partial : bool   passed, or failed by a typical mistake the check names (partial credit)
+    mark : str       the verdict's word: "passed" / "not yet" for a check; "earned" / "not earned"
+                     for partial credit, whose point a named mistake earns while its check says "not yet"
     """
 
-    def __init__(self, name, passed, message, written=True, partial=None):
+    def __init__(self, name, passed, message, written=True, partial=None, mark=None):
         self.name, self.passed, self.message = name, bool(passed), message
         self.written = bool(written)
         self.partial = self.passed if partial is None else bool(partial)
+        self.mark = mark or ("passed" if self.passed else "not yet")
 
     def __bool__(self):
         return self.passed
 
     def __repr__(self):
-        mark = "passed" if self.passed else "not yet"
-        return f"{self.name}: {mark}. {self.message}"
+        return f"{self.name}: {self.mark}. {self.message}"
+
+    @property
+    def said(self):
+        """The verdict as grading states it: ``NAME: MESSAGE`` for a check (a failure is its
+        diagnosis), ``NAME, partial credit: earned. MESSAGE`` or ``... not earned. ...`` for
+        partial credit, so that a grader reads a named mistake's point as earned, not as a pass."""
+        plain = self.mark in ("passed", "not yet")
+        return f"{self.name}: {self.message}" if plain else f"{self.name}: {self.mark}. {self.message}"
 
     def _repr_html_(self):
-        colour, mark = ("#1a7f37", "✔ passed") if self.passed else ("#b35900", "✘ not yet")
+        colour, sign = ("#1a7f37", "✔") if self.passed else ("#b35900", "✘")
         return (
             f'<div class="geomlib-check" style="border-left:4px solid {colour};padding:0.3em 0.8em">'
-            f'<b>{html.escape(self.name)}</b>: <b style="color:{colour}">{mark}</b>. '
+            f'<b>{html.escape(self.name)}</b>: <b style="color:{colour}">{sign} {self.mark}</b>. '
             f"{html.escape(self.message)}</div>"
         )
 
@@ -375,7 +385,7 @@ def _enforce(result):
     """``result``, or CheckFailed with its message: for any failure while nbgrader grades,
     for a written function's failure under the strict test run."""
     if not result.passed and (graded() or (strict_claims() and result.written)):
-        raise CheckFailed(f"{result.name}: {result.message}")
+        raise CheckFailed(result.said)
     return result
 
 
@@ -473,14 +483,17 @@ def earlier(fn, name, *args):
 def credit(result):
     """The partial-credit verdict on a check's ``result``: right, or a typical mistake the check names."""
     if result.passed:
-        message = "earned: the function passes its check."
+        mark, message = "earned", "the function passes its check."
     elif result.partial:
-        message = "earned: what is wrong is a typical mistake, named by the check above."
+        mark, message = (
+            "earned",
+            "what is wrong is a typical mistake, named by the check above; its fix earns the check's points.",
+        )
     elif not result.written:
-        message = result.message
+        mark, message = "not yet", result.message
     else:
-        message = f"not earned: the check cannot name what is wrong. {result.message}"
-    return CheckResult(f"{result.name}, partial credit", result.partial, message, written=result.written)
+        mark, message = "not earned", f"the check cannot name what is wrong. {result.message}"
+    return CheckResult(f"{result.name}, partial credit", result.partial, message, written=result.written, mark=mark)
 
 
 def use(fn, check, reference):
