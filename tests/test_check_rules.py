@@ -46,10 +46,7 @@ SHORTCUTS = {
     "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
     "denoising_metrics": geomlib.denoising_metrics,
-    "denoising_experiment": lambda V, F, sigma, tau, iterations, seeds: (
-        np.mean([geomlib.denoising_experiment(V, F, sigma, tau, iterations, seed)[0] for seed in seeds]),
-        np.std([geomlib.denoising_experiment(V, F, sigma, tau, iterations, seed)[0] for seed in seeds], ddof=1),
-    ),
+    "denoising_experiment": geomlib.denoising_spread,
     "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
     "taubin_smoothing": lambda V, F, tau_shrink, tau_inflate, pairs: geomlib.taubin_smoothing(
         V, F, tau_shrink, tau_inflate, pairs

@@ -325,7 +325,7 @@ SPREAD_MISTAKES = [
 @exercise(
     "denoising_experiment",
     reread="section 4 · The experiment, yours",
-    forbid=(*named("lessons.noise", "denoising_experiment add_noise"), *_METRICS, *_SWEEPS),
+    forbid=(*named("lessons.noise", "denoising_experiment denoising_spread add_noise"), *_METRICS, *_SWEEPS),
     allow=("lessons.smoothing.implicit_smoothing", "mesh.geometry.enclosed_volume"),  # the latter in your measures
 )
 def denoising_experiment(fn):
