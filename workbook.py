@@ -8,6 +8,7 @@
     python3 workbook.py assignment # the assignment version in build/assignment/
     python3 workbook.py site       # the workbook as a static website in build/site/
     python3 workbook.py run 05 STEP=1e-4 ...   # one notebook with those parameters, into build/runs/
+    python3 workbook.py course autograde COURSE ASSIGNMENT --workers 4   # geomlib-course (docs/grading.md)
     python3 workbook.py setup      # only create or update .venv
 
 Each creates the virtual environment ``.venv`` beside this file when it is
@@ -16,7 +17,8 @@ missing, and (re)installs the pinned package set (``constraints.txt``) when
 Needs only Python 3.11 or newer with its standard ``venv`` module.
 Extra arguments after ``test`` go to pytest, after ``lab`` to JupyterLab,
 after ``notebook`` to Jupyter Notebook; ``run`` takes a notebook and NAME=VALUE
-pairs (tools/run_notebook.py says more).
+pairs (tools/run_notebook.py says more); ``course`` runs the lecturer's
+``geomlib-course`` with the arguments given, in the caller's folder.
 
 ``lab`` and ``notebook`` open the exercise version (stubs where the solutions
 are, empty answer boxes; built as ``assignment`` builds it) in a working folder
@@ -181,7 +183,7 @@ def test_workers(args):
 
 
 def main(argv):
-    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment", "site", "run"):
+    if not argv or argv[0] not in ("lab", "notebook", "test", "setup", "assignment", "site", "run", "course"):
         print(__doc__)
         return 2
     command, rest = argv[0], argv[1:]
@@ -197,6 +199,10 @@ def main(argv):
     if command == "run":
         # in the caller's folder: relative paths in the values are relative to it
         return subprocess.call([str(PY), str(ROOT / "tools" / "run_notebook.py"), *rest], env=env)
+    if command == "course":
+        # the lecturer's geomlib-course, with the environment's bin/ first on PATH (nbgrader calls alembic)
+        env["PATH"] = f"{BIN}{os.pathsep}{env.get('PATH', '')}"
+        return subprocess.call([str(PY), "-m", "geomlib.course.cli", *rest], env=env)
     if command in ("lab", "notebook"):
         solutions, work, rest = front_end_options(rest)
         folder = open_folder(solutions, work, env)

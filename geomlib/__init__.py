@@ -89,6 +89,7 @@ _EXPORTS = {
     # noise and evaluation
     "add_noise": "lessons.noise",
     "denoising_experiment": "lessons.noise",
+    "denoising_spread": "lessons.noise",
     "denoising_sweep": "lessons.noise",
     "bounding_box_diagonal": "mesh.geometry",
     "vertex_rms": "lessons.metrics",

@@ -2,12 +2,15 @@
 (numpy and scipy only; right variants pass whatever the cases' seed, each typical mistake gets its own
 diagnosis), and every wrong C of the check's own catalogue, handed in, gets its own diagnosis."""
 
+import types
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 from diagnoses import assert_diagnosed, replaying
 
 from geomlib import check
+from geomlib.lessons.curvature import signed_mean_curvature
 from geomlib.lessons.laplace import edge_lengths, intrinsic_cotangent_matrix
 from geomlib.teaching.check import cotangent as catalogues
 
@@ -185,18 +188,17 @@ def test_mixed_areas_per_face_values_and_the_shortcut():
     assert not result.partial
 
 
-# ---------------------------------------------------------------- discrete_principal_curvatures(V, F, M, C, deficit)
-def learner_kappas(V, F, M, C, deficit, sign=-0.5, unit=True, per_area=True, clamp=np.maximum, order=1, absolute=False):
-    """kappa_1,2 from the signed H (area-weighted normals) and K = deficit / A, with the mistakes as switches."""
-    A = M.diagonal()
-    DX = (C @ V) / A[:, None]
-    cross = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    N = np.zeros_like(V)
-    for corner in F.T:
-        np.add.at(N, corner, cross)
-    if unit:
-        N /= np.linalg.norm(N, axis=1, keepdims=True)
-    H = sign * np.sum(DX * N, axis=1)
+# ---------------------------------------------------------------- discrete_principal_curvatures(V, F, deficit)
+# the learner's routines of sections 1 and 2, right, in the namespace the answers below are written in
+my_cotangent_matrix, my_mixed_areas = learner_C, learner_mixed
+
+
+def learner_kappas(V, F, deficit, areas=None, sign=1.0, per_area=True, clamp=np.maximum, order=1, absolute=False):
+    """kappa_1,2 from the learner's C and mixed areas, H of signed_mean_curvature, K = deficit / A; mistakes as
+    switches (``areas``: what M holds, from the mixed areas A)."""
+    C = my_cotangent_matrix(edge_lengths(V, F), F)
+    A = my_mixed_areas(V, F)
+    H = sign * signed_mean_curvature(V, F, sp.diags(A if areas is None else areas(A)), C)
     H = np.abs(H) if absolute else H
     K = deficit / A if per_area else deficit
     with np.errstate(invalid="ignore"):
@@ -204,19 +206,22 @@ def learner_kappas(V, F, M, C, deficit, sign=-0.5, unit=True, per_area=True, cla
     return (H + root, H - root)[::order]
 
 
-def learner_kappas_loop(V, F, M, C, deficit):
-    """Another right answer: dense matrices, normals summed in a loop over faces, the clamp by np.where."""
-    Minv = np.diag(1 / np.diag(M.toarray()))
-    Lx = Minv @ C.toarray() @ V
-    N = np.zeros((len(V), 3))
-    for i, j, k in F:
-        N[[i, j, k]] += np.cross(V[j] - V[i], V[k] - V[i])
-    H = np.array([-0.5 * Lx[v] @ N[v] / np.linalg.norm(N[v]) for v in range(len(V))])
-    K = deficit / np.diag(M.toarray())
-    d = H**2 - K
-    with np.errstate(invalid="ignore"):
+def learner_kappas_loop(V, F, deficit):
+    """Another right answer: dense matrices, a loop over the vertices, the clamp by np.where."""
+    M = np.diag(my_mixed_areas(V, F))
+    C = np.asarray(my_cotangent_matrix(edge_lengths(V, F), F).todense())
+    H = signed_mean_curvature(V, F, M, C)
+    k1, k2 = np.empty(len(V)), np.empty(len(V))
+    for i in range(len(V)):
+        d = H[i] ** 2 - deficit[i] / M[i, i]
         s = np.sqrt(np.where(d < 0, 0.0, d))  # NaN < 0 is False: the boundary's NaN goes through
-    return [H + s, H - s]
+        k1[i], k2[i] = H[i] + s, H[i] - s
+    return [k1, k2]
+
+
+def beside(fn, **yours):
+    """``fn`` written in a notebook whose earlier routines are ``yours`` (my_cotangent_matrix=..., ...)."""
+    return types.FunctionType(fn.__code__, {**fn.__globals__, **yours}, fn.__name__, fn.__defaults__)
 
 
 KAPPA_MISTAKES = {
@@ -224,10 +229,11 @@ KAPPA_MISTAKES = {
     "integrated K": (lambda *a: learner_kappas(*a, per_area=False), "not divided by the area"),
     "no clamp": (lambda *a: learner_kappas(*a, clamp=lambda d, _: d), "is not clamped"),
     "|H^2 - K|": (lambda *a: learner_kappas(*a, clamp=lambda d, _: np.abs(d)), "|H^2 - K| is used"),
+    "no root": (lambda *a: learner_kappas(*a, clamp=lambda d, _: np.maximum(d, 0) ** 2), "the square root is missing"),
     "|H|": (lambda *a: learner_kappas(*a, absolute=True), "the sign of H is lost"),
-    "inward normals": (lambda *a: learner_kappas(*a, sign=0.5), "H has the wrong sign"),
-    "no 1/2": (lambda *a: learner_kappas(*a, sign=-1.0), "the factor 1/2 is missing"),
-    "raw normals": (lambda *a: learner_kappas(*a, unit=False), "the normals are not normalised"),
+    "-H": (lambda *a: learner_kappas(*a, sign=-1.0), "H has the wrong sign"),
+    "M = I in H": (lambda *a: learner_kappas(*a, areas=np.ones_like), "M is the identity in H"),
+    "M^-1": (lambda *a: learner_kappas(*a, areas=lambda A: 1 / A), "M^-1 is handed to signed_mean_curvature"),
     "boundary filled": (lambda *a: np.nan_to_num(learner_kappas(*a)), "have values at boundary vertices"),
     "one array (n, 2)": (lambda *a: np.stack(learner_kappas(*a), axis=1), "not the pair (kappa_1, kappa_2)"),
 }
@@ -237,7 +243,7 @@ KAPPA_MISTAKES = {
 @pytest.mark.parametrize("fn", [learner_kappas, learner_kappas_loop, lambda *a: np.stack(learner_kappas(*a))])
 def test_discrete_principal_curvatures_accept_correct_variants(fn, seed):
     result = check.discrete_principal_curvatures(fn, seed=seed)
-    assert result.passed and "barycentric (M, C)" in result.message, result.message
+    assert result.passed and "an irregular bipyramid" in result.message, result.message
 
 
 @pytest.mark.parametrize("name", KAPPA_MISTAKES)
@@ -246,6 +252,28 @@ def test_discrete_principal_curvatures_diagnoses(name):
     result = check.discrete_principal_curvatures(fn, seed=7)
     assert_diagnosed(result, phrase, "Reread section 5")
     assert result.partial == (name != "one array (n, 2)"), result.message
+
+
+@pytest.mark.parametrize(
+    "yours, phrase",
+    [
+        (dict(my_cotangent_matrix=lambda l, F: 2 * learner_C(l, F)), "your my_cotangent_matrix (section 1)"),
+        (dict(my_cotangent_matrix=lambda l, F: learner_C(l, F, diagonal=False)), "check.cotangent_matrix("),
+        (dict(my_mixed_areas=lambda V, F: learner_mixed(V, F, "plain")), "your my_mixed_areas (section 2)"),
+        (dict(my_mixed_areas=lambda V, F: learner_mixed(V, F, "barycentric")), "fix section 2 first"),
+    ],
+)
+@pytest.mark.parametrize("fn", [learner_kappas, lambda *a: learner_kappas(*a, order=-1)], ids=["right", "swapped"])
+def test_a_wrong_earlier_routine_is_named_as_the_exercise_to_fix(yours, phrase, fn):
+    result = check.discrete_principal_curvatures(beside(fn, **yours), seed=3)
+    assert_diagnosed(result, phrase, "names its mistake")
+    assert result.partial
+
+
+def test_earlier_routines_that_are_stubs_or_missing_leave_the_new_part_judged():
+    swapped = KAPPA_MISTAKES["swapped"][0]
+    result = check.discrete_principal_curvatures(beside(swapped, my_mixed_areas=None, my_cotangent_matrix=stub), seed=3)
+    assert not result.passed and "section 1" not in result.message and "section 2" not in result.message
 
 
 @pytest.mark.parametrize("seed", SEEDS)
@@ -259,7 +287,7 @@ def test_every_wrong_pair_of_the_catalogue_gets_its_own_diagnosis(entry, seed):
 
 def test_the_principal_cases_clamp_split_and_bend_both_ways():
     for seed in SEEDS:
-        cases = {c.label.split(" with")[0]: c for c in catalogues.principal_cases(np.random.default_rng(seed))}
+        cases = {c.label: c for c in catalogues.principal_cases(np.random.default_rng(seed))}
         ico, saddle, bump = (
             cases["a jittered icosphere"],
             cases["a saddle on a 4 x 4 grid"],
@@ -269,20 +297,36 @@ def test_the_principal_cases_clamp_split_and_bend_both_ways():
         inside = ~saddle.boundary
         assert (saddle.H[inside] < 0).any() and (saddle.H[inside] > 0).any() and (saddle.K[inside] < 0).all()
         assert bump.boundary.any() and np.isnan(bump.kappas[:, bump.boundary]).all()
+        bipyramid = cases["an irregular bipyramid"]  # obtuse: the mixed areas are not the barycentric ones
+        assert not np.allclose(bipyramid.A, bipyramid.bary)
 
 
 def test_discrete_principal_curvatures_stub_and_the_shortcuts():
     assert_diagnosed(check.discrete_principal_curvatures(stub), "not written yet")
-    from geomlib import discrete_principal_curvatures, principal_curvatures, vertex_normals
+    from geomlib import discrete_principal_curvatures, laplacian, principal_curvatures
+    from geomlib.lessons.curvature import mixed_principal_curvatures
 
-    result = check.discrete_principal_curvatures(discrete_principal_curvatures)
-    assert_diagnosed(result, "`discrete_principal_curvatures`", "asks you to write")
+    result = check.discrete_principal_curvatures(mixed_principal_curvatures)
+    assert_diagnosed(result, "`mixed_principal_curvatures`", "asks you to write")
     assert not result.partial
 
-    def with_geomlib_normals(V, F, M, C, deficit):
-        N = vertex_normals(V, F)
-        return principal_curvatures(-0.5 * np.sum((C @ V) / M.diagonal()[:, None] * N, axis=1), deficit / M.diagonal())
+    def with_geomlib_pair(V, F, deficit):
+        M, C = laplacian(V, F, area="mixed")
+        return discrete_principal_curvatures(V, F, M, C, deficit)
 
-    result = check.discrete_principal_curvatures(with_geomlib_normals)
-    assert_diagnosed(result, "earns no points")
-    assert not result.partial
+    def with_geomlib_kappas(V, F, deficit):
+        A = my_mixed_areas(V, F)
+        return principal_curvatures(
+            signed_mean_curvature(V, F, sp.diags(A), learner_C(edge_lengths(V, F), F)), deficit / A
+        )
+
+    for fn, named in ((with_geomlib_pair, "`laplacian`"), (with_geomlib_kappas, "`principal_curvatures`")):
+        result = check.discrete_principal_curvatures(fn)
+        assert_diagnosed(result, named, "earns no points")
+        assert not result.partial
+
+
+def test_the_rules_name_the_routines_handed_out_and_the_learners_own():
+    rules = check.discrete_principal_curvatures.rules
+    assert "`edge_lengths` and `signed_mean_curvature`" in rules
+    assert "your own `my_cotangent_matrix` and `my_mixed_areas`" in rules

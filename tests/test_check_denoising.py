@@ -229,13 +229,22 @@ def _rms(P, V):
     return float(np.sqrt(np.mean(np.sum((P - V) ** 2, axis=1))))
 
 
-def experiment(noise, measure, smooth_noisy=True):
-    """An experiment from its parts, written fresh: noise(V, sigma, seed) -> W, measure(P, W, V) -> float."""
+def _sample(E, E_noisy):
+    return float(np.mean(E)), float(np.std(E, ddof=1))
 
-    def fn(V, F, sigma, tau, iterations, seed):
-        W = noise(V, sigma, seed)
-        P = geomlib.implicit_smoothing(W if smooth_noisy else V, F, tau, iterations)
-        return measure(P, W, V)
+
+def experiment(noise, measure, smooth_noisy=True, spread=_sample, draws=lambda seeds: seeds):
+    """An experiment from its parts, written fresh: noise(V, sigma, seed) -> W, measure(P, W, V) -> float per
+    draw, spread(E, E_noisy) -> (E_mean, E_std) over them, draws(seeds) the seeds actually drawn."""
+
+    def fn(V, F, sigma, tau, iterations, seeds):
+        E, E_noisy = [], []
+        for seed in draws(seeds):
+            W = noise(V, sigma, seed)
+            P = geomlib.implicit_smoothing(W if smooth_noisy else V, F, tau, iterations)
+            E.append(measure(P, W, V))
+            E_noisy.append(relative(W, W, V))
+        return spread(np.array(E), np.array(E_noisy))
 
     return fn
 
@@ -248,10 +257,13 @@ def relative(P, W, V):
     return _rms(P, V) / bounding_box_diagonal(V)
 
 
-def edge_noise(V, F, sigma, tau, iterations, seed):
+def edge_noise(V, F, sigma, tau, iterations, seeds):
     ell = np.linalg.norm(V[F[:, [1, 2, 0]]] - V[F], axis=2).mean()  # every edge twice on a closed mesh: the mean edge
-    W = V + sigma * ell * np.random.default_rng(seed).standard_normal(V.shape)
-    return relative(geomlib.implicit_smoothing(W, F, tau, iterations), W, V)
+    E = []
+    for seed in seeds:
+        W = V + sigma * ell * np.random.default_rng(seed).standard_normal(V.shape)
+        E.append(relative(geomlib.implicit_smoothing(W, F, tau, iterations), W, V))
+    return np.mean(E), np.std(E, ddof=1)
 
 
 # correct variants: another draw of the same noise, columns drawn first, a float32 error
@@ -282,7 +294,28 @@ WRONG_EXPERIMENTS = {
         experiment(lambda V, s, seed: V + s * bounding_box_diagonal(V) * np.random.standard_normal(V.shape), relative),
         "not seeded",
     ),
-    "seed ignored": (experiment(lambda V, s, seed: seeded(V, s, 0), relative), "seed is ignored"),
+    "seed ignored": (experiment(lambda V, s, seed: seeded(V, s, 0), relative), "seeds are ignored"),
+    "seeds by their index": (experiment(seeded, relative, draws=lambda seeds: range(len(seeds))), "seeds are ignored"),
+    "the same seed for every draw": (
+        experiment(seeded, relative, draws=lambda seeds: [seeds[0]] * len(seeds)),
+        "same seed made every draw",
+    ),
+    "ddof = 2": (
+        experiment(seeded, relative, spread=lambda E, En: (E.mean(), E.std(ddof=2))),
+        "not that of your own draws",
+    ),
+    "population std": (
+        experiment(seeded, relative, spread=lambda E, En: (E.mean(), E.std())),
+        "population one (ddof = 0)",
+    ),
+    "the std of the noisy meshes": (
+        experiment(seeded, relative, spread=lambda E, En: (E.mean(), En.std(ddof=1))),
+        "standard deviation is that of the noisy meshes",
+    ),
+    "the mean of the noisy meshes": (
+        experiment(seeded, relative, spread=lambda E, En: (En.mean(), E.std(ddof=1))),
+        "error is that of the noisy mesh",
+    ),
     "absolute error": (experiment(seeded, lambda P, W, V: _rms(P, V)), "error is absolute"),
     "noise not relative": (
         experiment(lambda V, s, seed: V + s * np.random.default_rng(seed).standard_normal(V.shape), relative),
@@ -314,13 +347,16 @@ WRONG_EXPERIMENTS = {
         ),
         "sqrt(3) too small",
     ),
-    "returns the meshes": (experiment(seeded, lambda P, W, V: (relative(P, W, V), P)), "not a number"),
+    "returns the meshes": (
+        experiment(seeded, relative, spread=lambda E, En: (E.mean(), E.std(ddof=1), En)),
+        "not return the pair",
+    ),
     "one iteration short": (
-        lambda V, F, s, tau, n, seed: experiment(seeded, relative)(V, F, s, tau, max(n - 1, 0), seed),
+        lambda V, F, s, tau, n, seeds: experiment(seeded, relative)(V, F, s, tau, max(n - 1, 0), seeds),
         "one iteration short",
     ),
     "one iteration too many": (
-        lambda V, F, s, tau, n, seed: experiment(seeded, relative)(V, F, s, tau, n + 1, seed),
+        lambda V, F, s, tau, n, seeds: experiment(seeded, relative)(V, F, s, tau, n + 1, seeds),
         "one iteration too many",
     ),
     "mean over the 3n coordinates": (
@@ -345,6 +381,7 @@ def test_wrong_experiments_are_diagnosed(name):
 def test_typical_experiment_mistakes_earn_partial_credit_and_catch_alls_do_not():
     assert check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["against the noisy mesh"][0]).partial
     assert check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["unseeded"][0]).partial
+    assert check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["population std"][0]).partial
     assert not check.denoising_experiment.evaluate(WRONG_EXPERIMENTS["returns the meshes"][0]).partial
 
 

@@ -33,6 +33,9 @@ SHORTCUTS = {
     "mean_curvature": lambda V, F, M, C: geomlib.mean_curvature(V, F, "uniform", signed=True, boundary="nan"),
     "cotangent_matrix": lambda l, F: intrinsic_cotangent_matrix(l, F),
     "mixed_areas": lambda V, F: geomlib.vertex_areas(V, F, area="mixed"),
+    "discrete_principal_curvatures": lambda V, F, deficit: geomlib.lessons.curvature.mixed_principal_curvatures(
+        V, F, deficit
+    ),
     "spectral_reconstruction": lambda V, F, ks, solve: spectral.spectral_reconstructions(V, F, ks, solve),
     "eigenpairs": lambda M, C, k: spectral.eigenpairs(M, C, k),
     "lam_max": lambda M, C: eigen.largest_eigenvalue(
@@ -43,9 +46,7 @@ SHORTCUTS = {
     "smoothing_loop": lambda V, F, tau, iterations: geomlib.explicit_smoothing(V, F, tau, iterations),
     "add_noise": geomlib.add_noise,
     "denoising_metrics": geomlib.denoising_metrics,
-    "denoising_experiment": lambda V, F, sigma, tau, iterations, seed: geomlib.denoising_experiment(
-        V, F, sigma, tau, iterations, seed
-    )[0],
+    "denoising_experiment": geomlib.denoising_spread,
     "denoising_sweep": lambda W, F, V_clean, taus, iterations: geomlib.denoising_sweep(W, F, V_clean, taus, iterations),
     "taubin_smoothing": lambda V, F, tau_shrink, tau_inflate, pairs: geomlib.taubin_smoothing(
         V, F, tau_shrink, tau_inflate, pairs

@@ -10,6 +10,7 @@ measures: no right routine fails, no wrong routine passes, and at least 80 % of 
 
 import functools
 import re
+import types
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from geomlib import boundary_vertices, check, implicit_smoothing, laplacian
+from geomlib import boundary_vertices, check, enclosed_volume, implicit_smoothing, laplacian
+from geomlib.lessons.curvature import signed_mean_curvature
 from geomlib.lessons.laplace import edge_lengths
 
 SEED = 20261128  # the checks' cases, drawn as one run of a class would draw them
@@ -658,100 +660,112 @@ def mixed_halves_swapped(V, F):
 
 
 # ============================================================================ 03 · discrete_principal_curvatures
+# The answer builds on the learner's routines of sections 1 and 2, looked up where it is written: here, a
+# notebook whose sections 1 and 2 hold these two right ones (``written_beside`` gives another notebook).
+my_cotangent_matrix, my_mixed_areas = cotmatrix_lil, mixed_loop
+
+
+def written_beside(**earlier):
+    """The routine as written in a notebook whose earlier routines are ``earlier`` (my_cotangent_matrix=...)."""
+
+    def rebind(fn):
+        return types.FunctionType(fn.__code__, {**fn.__globals__, **earlier}, fn.__name__, fn.__defaults__)
+
+    return rebind
 
 
 @student("discrete_principal_curvatures")
-def principal_face_loop(V, F, M, C, deficit):
-    n = len(V)
-    normal = np.zeros((n, 3))
-    for a, b, c in F:
-        normal[[a, b, c]] += np.cross(V[b] - V[a], V[c] - V[a])
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
-    area = M.diagonal()
-    lap = (C @ V) / area[:, None]
-    k1, k2 = np.zeros(n), np.zeros(n)
-    for i in range(n):
-        H = -0.5 * lap[i].dot(normal[i])
-        K = deficit[i] / area[i]
-        disc = max(H * H - K, 0.0) if not np.isnan(K) else np.nan
-        k1[i], k2[i] = H + np.sqrt(disc), H - np.sqrt(disc)
+def principal_own_pair(V, F, deficit):
+    l = edge_lengths(V, F)
+    C = my_cotangent_matrix(l, F)
+    areas = my_mixed_areas(V, F)
+    M = sp.diags(areas)
+    H = signed_mean_curvature(V, F, M, C)
+    K = deficit / areas
+    disc = np.maximum(H**2 - K, 0)
+    k1 = H + np.sqrt(disc)
+    k2 = H - np.sqrt(disc)
     return k1, k2
 
 
 @student("discrete_principal_curvatures")
-def principal_sparse_incidence(V, F, M, C, deficit):
-    m = len(F)
-    faces_at = sp.csr_matrix((np.ones(3 * m), (F.ravel(), np.repeat(np.arange(m), 3))), shape=(len(V), m))
-    n_f = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    n_v = faces_at @ n_f
-    n_v = n_v / np.sqrt((n_v**2).sum(axis=1, keepdims=True))
-    Minv = sp.diags(1.0 / M.diagonal())
-    H = -0.5 * ((Minv @ C @ V) * n_v).sum(axis=1)
-    K = Minv @ deficit
-    delta = np.clip(H**2 - K, 0, None)
-    return np.vstack([H + np.sqrt(delta), H - np.sqrt(delta)])
+def principal_vertex_loop(V, F, deficit):
+    A = my_mixed_areas(V, F)
+    C = my_cotangent_matrix(edge_lengths(V, F), F)
+    H = signed_mean_curvature(V, F, np.diag(A), C)
+    kappa1, kappa2 = np.full(len(V), np.nan), np.full(len(V), np.nan)
+    for i in range(len(V)):
+        if np.isnan(H[i]) or np.isnan(deficit[i]):
+            continue  # boundary vertex
+        r = np.sqrt(max(H[i] ** 2 - deficit[i] / A[i], 0.0))
+        kappa1[i], kappa2[i] = H[i] + r, H[i] - r
+    return kappa1, kappa2
 
 
-@student("discrete_principal_curvatures", named="H is unsigned")
-def principal_norm_of_laplacian(V, F, M, C, deficit):
-    A = M.diagonal()
-    H = 0.5 * np.linalg.norm(C @ V, axis=1) / A  # the mean curvature normal's length
+@student("discrete_principal_curvatures", named="is not clamped")
+def principal_no_clamp(V, F, deficit):
+    C = my_cotangent_matrix(edge_lengths(V, F), F)
+    A = my_mixed_areas(V, F)
+    H = signed_mean_curvature(V, F, sp.diags(A), C)
+    r = np.sqrt(H**2 - deficit / A)
+    return H + r, H - r
+
+
+@student("discrete_principal_curvatures", named="K is the deficit itself")
+def principal_integrated_k(V, F, deficit):
+    M = sp.diags(my_mixed_areas(V, F))
+    C = my_cotangent_matrix(edge_lengths(V, F), F)
+    H = signed_mean_curvature(V, F, M, C)
+    K = deficit  # the angle deficit is the Gaussian curvature
+    root = np.sqrt(np.maximum(H * H - K, 0))
+    return H + root, H - root
+
+
+@student("discrete_principal_curvatures", named="M is the identity in H")
+def principal_identity_mass(V, F, deficit):
+    C = my_cotangent_matrix(edge_lengths(V, F), F)
+    A = my_mixed_areas(V, F)
+    H = signed_mean_curvature(V, F, sp.identity(len(V)), C)  # M only for K
     K = deficit / A
     s = np.sqrt(np.maximum(H**2 - K, 0))
     return H + s, H - s
 
 
-@student("discrete_principal_curvatures", named="is not clamped")
-def principal_no_clamp(V, F, M, C, deficit):
-    normals = np.zeros(V.shape)
-    for c in range(3):
-        e1 = V[F[:, (c + 1) % 3]] - V[F[:, c]]
-        e2 = V[F[:, (c + 2) % 3]] - V[F[:, c]]
-        np.add.at(normals, F[:, c], np.cross(e1, e2))
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    H = -0.5 * np.einsum("ij,ij->i", sp.diags(1 / M.diagonal()) @ (C @ V), normals)
-    K = deficit / M.diagonal()
-    r = np.sqrt(H**2 - K)
-    return H + r, H - r
-
-
-@student("discrete_principal_curvatures", named="kappa_1 < kappa_2")
-def principal_swapped_and_integrated(V, F, M, C, deficit):
-    N = np.zeros((len(V), 3))
-    for tri in F:
-        i, j, k = tri
-        N[tri] += np.cross(V[j] - V[i], V[k] - V[i])
-    N = N / np.linalg.norm(N, axis=1)[:, None]
-    H = -0.5 * np.sum((C @ V) / M.diagonal()[:, None] * N, axis=1)
-    K = deficit  # the angle deficit is the Gaussian curvature
-    root = np.sqrt(np.maximum(H * H - K, 0))
-    return H - root, H + root
+@student("discrete_principal_curvatures", named="M^-1 is handed to signed_mean_curvature")
+def principal_inverse_mass(V, F, deficit):
+    A = my_mixed_areas(V, F)
+    Minv = sp.diags(1.0 / A)  # M^-1 C x
+    H = signed_mean_curvature(V, F, Minv, my_cotangent_matrix(edge_lengths(V, F), F))
+    d = np.clip(H**2 - deficit / A, 0, None)
+    return H + np.sqrt(d), H - np.sqrt(d)
 
 
 @student("discrete_principal_curvatures", named="have values at boundary vertices")
-def principal_nan_to_num(V, F, M, C, deficit):
-    cr = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    nrm = np.zeros_like(V)
-    for c in range(3):
-        np.add.at(nrm, F[:, c], cr)
-    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
-    H = -0.5 * np.einsum("ij,ij->i", (C @ V) / M.diagonal()[:, None], nrm)
-    K = np.nan_to_num(deficit) / M.diagonal()  # the NaNs gave warnings
-    d = np.sqrt(np.maximum(H**2 - K, 0.0))
-    return H + d, H - d
+def principal_nan_to_num(V, F, deficit):
+    A = my_mixed_areas(V, F)
+    H = signed_mean_curvature(V, F, sp.diags(A), my_cotangent_matrix(edge_lengths(V, F), F))
+    K = np.nan_to_num(deficit) / A  # the NaNs gave warnings
+    d = np.sqrt(np.maximum(np.nan_to_num(H) ** 2 - K, 0.0))
+    return np.nan_to_num(H) + d, np.nan_to_num(H) - d
 
 
-@student("discrete_principal_curvatures", named="with a sign: the part of M^-1 C x along the surface")
-def principal_meyer_magnitude(V, F, M, C, deficit):
-    # Meyer et al.: kappa_H = 1/2 |K(x_i)|, the mean curvature normal's length, its sign from the normal
-    K_vec = -(C @ V) / M.diagonal()[:, None]
-    n = np.zeros_like(V)
-    for corner in range(3):
-        np.add.at(n, F[:, corner], np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]))
-    H = 0.5 * np.linalg.norm(K_vec, axis=1) * np.sign(np.sum(K_vec * n, axis=1))
-    kG = deficit / M.diagonal()
-    sq = np.sqrt(np.maximum(H**2 - kG, 0))
-    return H + sq, H - sq
+@student("discrete_principal_curvatures", named="your my_cotangent_matrix (section 1) returns a wrong C")
+@written_beside(my_cotangent_matrix=cotmatrix_no_half)
+def principal_on_a_wrong_c(V, F, deficit):
+    C = my_cotangent_matrix(edge_lengths(V, F), F)
+    A = my_mixed_areas(V, F)
+    H = signed_mean_curvature(V, F, sp.diags(A), C)
+    root = np.sqrt(np.maximum(H**2 - deficit / A, 0.0))
+    return H + root, H - root
+
+
+@student("discrete_principal_curvatures", named="your my_mixed_areas (section 2) returns wrong areas")
+@written_beside(my_mixed_areas=mixed_is_barycentric)
+def principal_on_barycentric_areas_swapped(V, F, deficit):
+    A = my_mixed_areas(V, F)
+    H = signed_mean_curvature(V, F, sp.diags(A), my_cotangent_matrix(edge_lengths(V, F), F))
+    root = np.sqrt(np.maximum(H**2 - deficit / A, 0.0))
+    return H - root, H + root  # and the pair swapped: section 2 is named first
 
 
 # ============================================================================ 04 · eigenpairs
@@ -1404,45 +1418,116 @@ def metrics_noisy_diagonal(V, V_clean, F):
     }
 
 
-@student("denoising_metrics", named="unsigned")
-def metrics_unsigned_volume(V, V_clean, F):
+@student("denoising_metrics", named="ratio vol / vol_clean")
+def metrics_volume_ratio(V, V_clean, F):
     d = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
     cos = np.clip((_unit_normals(V, F) * _unit_normals(V_clean, F)).sum(1), -1, 1)
-    vol = np.abs(np.linalg.det(V[F])).sum() / 6  # a volume is positive
-    vol0 = np.abs(np.linalg.det(V_clean[F])).sum() / 6
     return {
         "rms": np.sqrt(((V - V_clean) ** 2).sum(1).mean()) / d,
         "normal_mean": np.degrees(np.arccos(cos)).mean(),
-        "volume_change": (vol - vol0) / vol0,
+        "volume_change": enclosed_volume(V, F) / enclosed_volume(V_clean, F),  # how much of the volume is left
     }
+
+
+@student("denoising_metrics", named="sign of the volume change is flipped")
+def metrics_volume_lost(V, V_clean, F):
+    diag = np.linalg.norm(np.ptp(V_clean, axis=0))
+    theta = np.arccos(np.clip(np.einsum("ij,ij->i", _unit_normals(V, F), _unit_normals(V_clean, F)), -1, 1))
+    vol0 = enclosed_volume(V_clean, F)
+    lost = (vol0 - enclosed_volume(V, F)) / abs(vol0)  # the share of the volume lost by smoothing
+    return {
+        "rms": np.linalg.norm(V - V_clean) / np.sqrt(len(V)) / diag,
+        "normal_mean": np.degrees(theta).mean(),
+        "volume_change": lost,
+    }
+
+
+@student("denoising_metrics")
+def metrics_handed_volume(V, V_clean, F):
+    diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
+    theta = np.degrees(np.arccos(np.clip(np.sum(_unit_normals(V, F) * _unit_normals(V_clean, F), axis=1), -1, 1)))
+    vol, vol0 = enclosed_volume(V, F), enclosed_volume(V_clean, F)
+    return {"rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / diag, "normal_mean": theta.mean(),
+            "volume_change": (vol - vol0) / abs(vol0)}  # fmt: skip
 
 
 # ============================================================================ 07 · denoising_experiment
 
 
+def _noisy(V, sigma, seed):
+    return V + sigma * _diag(V) * np.random.default_rng(seed).standard_normal(V.shape)
+
+
+def _E(P, V):
+    return np.sqrt(np.mean(np.sum((P - V) ** 2, axis=1))) / _diag(V)
+
+
 @student("denoising_experiment")
-def experiment(V_clean, F, sigma, tau, iterations, seed):
-    d = _diag(V_clean)
-    W = V_clean + sigma * d * np.random.default_rng(seed).standard_normal(V_clean.shape)
-    P = implicit_smoothing(W, F, tau, iterations)
-    return np.sqrt(np.mean(np.sum((P - V_clean) ** 2, axis=1))) / d
+def experiment(V_clean, F, sigma, tau, iterations, seeds):
+    errors = []
+    for s in seeds:
+        P = implicit_smoothing(_noisy(V_clean, sigma, s), F, tau, iterations)
+        errors.append(_E(P, V_clean))
+    return np.mean(errors), np.std(errors, ddof=1)
+
+
+@student("denoising_experiment")
+def experiment_statistics(V_clean, F, sigma, tau, iterations, seeds):
+    import statistics
+
+    Es = [float(_E(implicit_smoothing(_noisy(V_clean, sigma, seed), F, tau, iterations), V_clean)) for seed in seeds]
+    return statistics.mean(Es), statistics.stdev(Es)  # stdev: the sample one, n - 1
+
+
+@student("denoising_experiment", named="population one (ddof = 0)")
+def experiment_population_std(V_clean, F, sigma, tau, iterations, seeds):
+    E = np.array([_E(implicit_smoothing(_noisy(V_clean, sigma, s), F, tau, iterations), V_clean) for s in seeds])
+    return E.mean(), E.std()
+
+
+@student("denoising_experiment", named="same seed made every draw")
+def experiment_one_seed(V_clean, F, sigma, tau, iterations, seeds):
+    W = _noisy(V_clean, sigma, seeds[0])
+    E = [_E(implicit_smoothing(W, F, tau, iterations), V_clean) for _ in seeds]  # the same noise each time
+    return np.mean(E), np.std(E, ddof=1)
+
+
+@student("denoising_experiment", named="standard deviation is that of the noisy meshes")
+def experiment_spread_of_noise(V_clean, F, sigma, tau, iterations, seeds):
+    E, E0 = [], []
+    for seed in seeds:
+        W = _noisy(V_clean, sigma, seed)
+        E0.append(_E(W, V_clean))
+        E.append(_E(implicit_smoothing(W, F, tau, iterations), V_clean))
+    return np.mean(E), np.std(E0, ddof=1)
+
+
+@student("denoising_experiment", named="seeds are ignored")
+def experiment_counted_seeds(V_clean, F, sigma, tau, iterations, seeds):
+    E = [_E(implicit_smoothing(_noisy(V_clean, sigma, k), F, tau, iterations), V_clean) for k in range(len(seeds))]
+    return np.mean(E), np.std(E, ddof=1)
 
 
 @student("denoising_experiment", named="one iteration short")
-def experiment_short(V_clean, F, sigma, tau, iterations, seed):
-    rng = np.random.default_rng(seed)
-    d = _diag(V_clean)
-    noisy = V_clean + rng.standard_normal(V_clean.shape) * sigma * d
-    smooth = implicit_smoothing(noisy, F, tau, max(iterations - 1, 0))  # "iterations must be at least 0"
-    return np.sqrt(((smooth - V_clean) ** 2).sum(axis=1).mean()) / d
+def experiment_short(V_clean, F, sigma, tau, iterations, seeds):
+    E = []
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        noisy = V_clean + rng.standard_normal(V_clean.shape) * sigma * _diag(V_clean)
+        smooth = implicit_smoothing(noisy, F, tau, max(iterations - 1, 0))  # "iterations must be at least 0"
+        E.append(np.sqrt(((smooth - V_clean) ** 2).sum(axis=1).mean()) / _diag(V_clean))
+    return sum(E) / len(E), np.std(E, ddof=1)
 
 
 @student("denoising_experiment", named="measured against the noisy mesh")
-def experiment_against_noisy(V_clean, F, sigma, tau, iterations, seed):
-    d = _diag(V_clean)
-    W = V_clean + sigma * d * np.random.default_rng(seed).standard_normal(V_clean.shape)
-    P = implicit_smoothing(W, F, tau, iterations)
-    return np.sqrt(np.mean(np.sum((P - W) ** 2, axis=1))) / d
+def experiment_against_noisy(V_clean, F, sigma, tau, iterations, seeds):
+    E = []
+    for seed in seeds:
+        W = _noisy(V_clean, sigma, seed)
+        E.append(
+            np.sqrt(np.mean(np.sum((implicit_smoothing(W, F, tau, iterations) - W) ** 2, axis=1))) / _diag(V_clean)
+        )
+    return np.mean(E), np.std(E, ddof=1)
 
 
 # ============================================================================ 07 · denoising_sweep
@@ -1863,7 +1948,7 @@ def metrics_unrooted(V, V_clean, F):
 def metrics_over_new_volume(V, V_clean, F):
     diag = np.linalg.norm(V_clean.max(axis=0) - V_clean.min(axis=0))
     n, n0 = _unit_normals(V, F), _unit_normals(V_clean, F)
-    vol, vol0 = (np.linalg.det(X[F]).sum() / 6 for X in (V, V_clean))
+    vol, vol0 = (enclosed_volume(X, F) for X in (V, V_clean))
     return {
         "rms": np.sqrt(np.mean(np.sum((V - V_clean) ** 2, axis=1))) / diag,
         "normal_mean": np.rad2deg(np.arccos(np.clip(np.sum(n * n0, axis=1), -1, 1))).mean(),
@@ -1872,11 +1957,12 @@ def metrics_over_new_volume(V, V_clean, F):
 
 
 @student("denoising_experiment", named="the error is absolute")
-def experiment_absolute(V_clean, F, sigma, tau, iterations, seed):
-    rng = np.random.default_rng(seed)
-    W = V_clean + sigma * _diag(V_clean) * rng.standard_normal(V_clean.shape)
-    P = implicit_smoothing(W, F, tau, iterations)
-    return float(np.sqrt(np.mean(np.linalg.norm(P - V_clean, axis=1) ** 2)))
+def experiment_absolute(V_clean, F, sigma, tau, iterations, seeds):
+    E = []
+    for seed in seeds:
+        P = implicit_smoothing(_noisy(V_clean, sigma, seed), F, tau, iterations)
+        E.append(float(np.sqrt(np.mean(np.linalg.norm(P - V_clean, axis=1) ** 2))))
+    return np.mean(E), np.std(E, ddof=1)
 
 
 @student("denoising_sweep", named="N_best is one too many")

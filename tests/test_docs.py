@@ -52,6 +52,7 @@ COMMANDS = [
     (r"python3 workbook\.py assignment\b", "tests/test_assignment.py::test_the_release_runs_with_the_stubs_and_reveals_nothing"),
     (r"python3 workbook\.py site\b", "tests/browser/test_site.py::test_page_offline"),
     (r"python3 workbook\.py run\b", "here"),  # names and ranges; runs: test_run_notebook.py
+    (r"python3 workbook\.py course\b", "tests/test_environment.py::test_workbook_course_runs_geomlib_course_in_its_environment"),
     (r"pip install \.$", "tests/test_install.py::test_installing_geomlib_keeps_an_existing_jupyterlab_4"),
     # pip builds the same wheel from a clone as from the checkout
     (r"pip install git\+", "tests/test_install.py::test_installing_geomlib_keeps_an_existing_jupyterlab_4"),

@@ -247,6 +247,29 @@ def test_workbook_opens_notebook_00_and_passes_arguments_on():
     assert (workbook.NOTEBOOKS / workbook.FIRST_NOTEBOOK).is_file()
 
 
+def test_workbook_course_runs_geomlib_course_in_its_environment(tmp_path):
+    # in the caller's folder, with the environment's bin/ first on PATH (nbgrader calls alembic)
+    import subprocess
+
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "workbook.py"), "course", "report", "--help"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("usage: geomlib-course report") and "course_dir" in done.stdout
+    missing = subprocess.run(
+        [sys.executable, str(ROOT / "workbook.py"), "course", "report", "no-such-course", "a1"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert missing.returncode != 0 and f"no course folder {tmp_path / 'no-such-course'}" in missing.stderr
+
+
 def test_lab_options_choose_the_version_and_the_working_folder(tmp_path):
     workbook = _workbook()
     assert workbook.front_end_options(["--port", "8899"]) == (False, workbook.WORK, ["--port", "8899"])

@@ -11,8 +11,8 @@
 * No markdown cell of a core holds more than about 250 words.
 * Before an exercise, no code cell imports (by name) a routine the exercise forbids, nor a
   ``reference_*`` routine: the student's namespace holds no answer one ``??`` away.
-* The solutions are routines, not lines: a median of at least 8 lines of code per exercise
-  over 01-07, none under 3.
+* The solutions are routines, not lines: at least 200 lines of code in all over 01-07, a
+  median of at least 8 per exercise, none under 3.
 """
 
 import ast
@@ -28,7 +28,7 @@ CORES = sorted((ROOT / "notebooks").glob("0[1-7]_*.ipynb"))
 BEGIN, END = "### BEGIN SOLUTION", "### END SOLUTION"
 HIDDEN = re.compile(r"### BEGIN HIDDEN TESTS\n(.*?)### END HIDDEN TESTS", re.S)
 MAX_CELL_WORDS = 250
-MIN_MEDIAN, MIN_LINES = 8, 3
+MIN_TOTAL, MIN_MEDIAN, MIN_LINES = 200, 8, 3
 
 
 def _nb(path):
@@ -262,7 +262,8 @@ def test_the_solutions_are_routines():
     sizes = solution_sizes()
     median = statistics.median(sizes.values())
     short = {name: n for name, n in sizes.items() if n < MIN_LINES}
-    assert median >= MIN_MEDIAN and not short, (
-        f"{len(sizes)} exercises, {sum(sizes.values())} solution lines in all, median {median} "
+    total = sum(sizes.values())
+    assert total >= MIN_TOTAL and median >= MIN_MEDIAN and not short, (
+        f"{len(sizes)} exercises, {total} solution lines in all (at least {MIN_TOTAL}), median {median} "
         f"(at least {MIN_MEDIAN}), under {MIN_LINES} lines: {short}; per exercise: {sizes}"
     )

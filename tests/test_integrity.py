@@ -376,6 +376,43 @@ def test_the_judge_refuses_lam_max_from_geomlibs_largest_eigenpair():
     assert found["lam_max"]["partial_credit"][0] is False
 
 
+@pytest.mark.slow
+def test_the_judge_finds_the_earlier_routine_an_answer_builds_on_in_the_sandbox():
+    """03's principal curvatures call the student's section-1 C: the judge's check asks it there and names it."""
+    nb = nbformat.read(ROOT / "notebooks" / "03_cotangent_laplace.ipynb", as_version=4)
+    for cell in nb.cells:
+        if cell.metadata.get("nbgrader", {}).get("grade_id") == "cotangent_matrix":
+            cell.source = cell.source.replace("def my_cotangent_matrix", "def right_C") + (
+                "\n\ndef my_cotangent_matrix(l, F):\n    return 2 * right_C(l, F)\n"
+            )
+    found = judge.verdicts(nb)
+    assert not found["cotangent_matrix"]["check"][0]
+    passed, message = found["discrete_principal_curvatures"]["check"]
+    assert not passed and "your my_cotangent_matrix (section 1) returns a wrong C" in message, message
+    assert found["mixed_areas"]["check"][0]
+
+
+@pytest.mark.slow
+def test_each_exercise_is_judged_in_a_fresh_process_of_its_own():
+    # the sandboxes of a notebook are forked from one process holding its imports: what one
+    # exercise's calls leave behind (here a count on the numpy module) must not reach the next
+    nb = nbformat.read(ROOT / "notebooks" / "05_explicit_smoothing.ipynb", as_version=4)
+    for cell in nb.cells:
+        grade_id = cell.metadata.get("nbgrader", {}).get("grade_id", "")
+        if grade_id == "lam_max":
+            cell.source = cell.source.replace("    return lam", "    np.lam_max_calls = 1\n    return lam")
+        if grade_id == "smoothing_loop":  # wrong, should it see a call of my_lam_max made before its own first
+            cell.source = cell.source.replace(
+                "    ### BEGIN SOLUTION\n",
+                "    ### BEGIN SOLUTION\n"
+                "    if getattr(np, 'lam_max_calls', 0) and not getattr(np, 'smooth_called', False):\n"
+                "        return V + 1.0\n"
+                "    np.smooth_called = True\n",
+            )
+    found = judge.verdicts(nb)
+    assert [found[e]["check"][0] for e in ("lam_max", "smoothing_loop")] == [True, True], found
+
+
 def hand_in(course, student, notebooks, edit):
     """The released notebooks ``notebooks`` as ``student`` hands them in, each solution cell through ``edit``."""
     out = course / "submitted" / student / ASSIGNMENT
@@ -451,7 +488,7 @@ def test_autograde_gives_the_honest_student_full_points_and_the_mistaken_one_few
     assert got["mistaken"]["01"] == (got["honest"]["01"][0] - wrong, got["honest"]["01"][1])
     assert got["mistaken"]["03"][0] == 0  # not handed in
     said = grade_cell_outputs(course, "mistaken", "01", "uniform_laplacian")
-    assert "the sign of C is flipped" in said[0] and "earned: what is wrong is a typical mistake" in said[1]
+    assert "the sign of C is flipped" in said[0] and "earned. what is wrong is a typical mistake" in said[1]
     assert all(
         "decided by the grading judge" in text for text in grade_cell_outputs(course, "honest", "03", "mixed_areas")
     )

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from geomlib import MeshError, add_noise
+import geomlib
+from geomlib import MeshError, add_noise, surfaces
 from geomlib.lessons.metrics import bounding_box_diagonal
 from geomlib.mesh.geometry import vertex_normals
 
@@ -139,3 +140,15 @@ def test_the_sweep_refuses_an_open_mesh_and_bad_steps():
             geomlib.denoising_sweep(S, G, S, taus, 2)
     with pytest.raises(MeshError, match="iterations"):
         geomlib.denoising_sweep(S, G, S, [1e-3], 1.5)
+
+
+def test_the_spread_is_the_mean_and_sample_std_of_single_draws():
+    S = surfaces.sphere(1.0, subdivisions=2)
+    E = [geomlib.denoising_experiment(S.V, S.F, 0.02, 1e-3, 3, s)[0] for s in (1, 2, 5)]
+    E_mean, E_std = geomlib.denoising_spread(S.V, S.F, 0.02, 1e-3, 3, (1, 2, 5))
+    assert E_mean == pytest.approx(sum(E) / 3, rel=1e-12)
+    assert E_std == pytest.approx(np.sqrt(sum((e - E_mean) ** 2 for e in E) / 2), rel=1e-12)  # ddof = 1
+    assert geomlib.denoising_spread(S.V, S.F, 0.02, 1e-3, 3, (4, 4))[1] == 0.0  # one pattern twice: no spread
+    for seeds, said in (((3,), "at least 2 draws"), ((1, 2.5), r"seeds\[1\] must be an integer")):
+        with pytest.raises(geomlib.MeshError, match=said):
+            geomlib.denoising_spread(S.V, S.F, 0.02, 1e-3, 3, seeds)

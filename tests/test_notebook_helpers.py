@@ -166,15 +166,33 @@ def test_while_nbgrader_grades_a_failed_check_raises_its_diagnosis_and_use_still
     assert "has not passed its check yet" in capsys.readouterr().out
 
 
+def test_while_graded_a_check_decides_each_function_once(monkeypatch, capsys):
+    calls = []
+
+    def double(x):
+        calls.append(1)
+        return 2 * x
+
+    monkeypatch.setenv("NBGRADER_EXECUTION", "autograde")
+    first = _check_double(double)  # the grade cell; its partial credit and use read the same verdict
+    assert _check_double.partial_credit(double).passed and use(double, _check_double, np.negative) is double
+    assert len(calls) == 1 and _check_double.evaluate(double) is first
+    assert _check_double.evaluate(double, seed=3).passed and len(calls) == 2  # a seed asked for: a run of its own
+    assert not _check_double.evaluate(lambda x: x).passed  # another function: its own verdict
+    monkeypatch.delenv("NBGRADER_EXECUTION")
+    _check_double(double), _check_double(double)
+    assert len(calls) == 4  # a reader's run checks afresh at every call
+
+
 def test_partial_credit_for_a_mistake_the_check_names(monkeypatch):
     monkeypatch.setenv("NBGRADER_EXECUTION", "validate")
     assert _check_double.partial_credit(lambda x: 2 * x).passed
     named = _check_double.partial_credit(lambda x: x)  # "nothing was doubled"
     assert named.passed and named.name == "double, partial credit"
     for wrong, reason in (
-        (lambda x: 3 * x, "not earned: the check cannot name what is wrong"),  # only the catch-all fits
-        (lambda x: x[:2], "not earned: the check cannot name what is wrong"),  # a wrong shape
-        (lambda x: 1 / 0, "not earned: the check cannot name what is wrong"),  # an exception
+        (lambda x: 3 * x, "not earned. the check cannot name what is wrong"),  # only the catch-all fits
+        (lambda x: x[:2], "not earned. the check cannot name what is wrong"),  # a wrong shape
+        (lambda x: 1 / 0, "not earned. the check cannot name what is wrong"),  # an exception
         (_stub, "not written yet"),
     ):
         with pytest.raises(CheckFailed, match=f"^double, partial credit: {reason}"):

@@ -52,7 +52,15 @@ from ..mesh.errors import MeshError, MeshWarning, format_indices
 from ..mesh.geometry import area_weighted_normals
 from ..mesh.topology import boundary_edge_counts, edges_at_unpaired_vertices
 from ..mesh.validate import as_mesh, check_choice
-from .laplace import FaceGeometry, assemble_laplacian, check_options, face_geometry, vertex_areas, warn_zero_area
+from .laplace import (
+    FaceGeometry,
+    assemble_laplacian,
+    check_options,
+    face_geometry,
+    laplacian,
+    vertex_areas,
+    warn_zero_area,
+)
 
 __all__ = [
     "mean_curvature",
@@ -359,3 +367,14 @@ def discrete_principal_curvatures(V, F, M, C, deficit):
     with np.errstate(divide="ignore", invalid="ignore"):  # where M_ii = 0, H is NaN and so are the kappas
         K = deficit / A  # pointwise: the deficit per unit area
     return principal_curvatures(H, K)
+
+
+def mixed_principal_curvatures(V, F, deficit):
+    """Notebook 03's ``kappa_1 >= kappa_2``, each (n,) float64 in 1/length, from the mesh and its angle deficits.
+
+    :func:`discrete_principal_curvatures` of the cotangent pair with the mixed Voronoi areas
+    (``laplacian(V, F, area="mixed")``, Meyer et al. 2003): the pair built from the edge lengths and
+    the mixed areas, ``H`` its signed mean curvature, ``K = deficit / M_ii``. NaN at boundary vertices.
+    """
+    M, C = laplacian(V, F, area="mixed")
+    return discrete_principal_curvatures(V, F, M, C, deficit)

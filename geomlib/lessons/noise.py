@@ -20,7 +20,7 @@ from .laplace import assemble_laplacian
 from .metrics import vertex_rms
 from .smoothing import explicit_smoothing, implicit_smoothing, implicit_step
 
-__all__ = ["add_noise", "denoising_experiment", "denoising_sweep", "DIRECTIONS"]
+__all__ = ["add_noise", "denoising_experiment", "denoising_spread", "denoising_sweep", "DIRECTIONS"]
 
 DIRECTIONS = ("isotropic", "normal")
 
@@ -93,6 +93,32 @@ def denoising_experiment(V_clean, F, sigma, tau, iterations, seed, method="impli
     smooth = implicit_smoothing if method == "implicit" else explicit_smoothing
     P = smooth(W, F, tau, iterations, weights, **options)
     return vertex_rms(P, V_clean), W, P
+
+
+def denoising_spread(V_clean, F, sigma, tau, iterations, seeds, **options):
+    """The experiment over several noise draws: the mean and the spread of the error E.
+
+    One draw's E depends on its noise pattern, so an evaluation reports E over draws:
+    ``E_s = denoising_experiment(V_clean, F, sigma, tau, iterations, s)[0]`` for each seed
+    ``s`` (implicit smoothing, cotangent weights unless ``weights=`` says otherwise), then
+    their mean and their sample standard deviation (``ddof=1``: the spread of the draws'
+    population estimated from these few).
+
+    Parameters
+    ----------
+    V_clean, F, sigma, tau, iterations : as :func:`denoising_experiment`
+    seeds : sequence of at least 2 ints, one noise draw each
+    **options : passed to :func:`denoising_experiment` (``method``, ``weights``, ...)
+
+    Returns
+    -------
+    (E_mean, E_std) : floats, relative errors (fractions of the clean mesh's diagonal)
+    """
+    seeds = [whole_number(f"seeds[{i}]", s) for i, s in enumerate(seeds)]
+    if len(seeds) < 2:
+        raise MeshError(f"seeds: a spread needs at least 2 draws, got {len(seeds)}")
+    E = [denoising_experiment(V_clean, F, sigma, tau, iterations, s, **options)[0] for s in seeds]
+    return float(np.mean(E)), float(np.std(E, ddof=1))
 
 
 def denoising_sweep(W, F, V_clean, taus, iterations):

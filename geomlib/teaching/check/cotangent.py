@@ -6,20 +6,22 @@ irregular tetrahedron (closed, no right angle), an irregular bipyramid (closed, 
 jittered 4 x 4 grid (open: boundary edges with one triangle), placed anew every run; its typical mistakes are
 rebuilt from the right per-corner cotangents and Heron's areas. ``mixed_areas`` names its mistakes from
 ``check.area_mistakes``, in the words every area check uses. ``discrete_principal_curvatures`` hands in the
-cotangent pair and the angle deficits (NaN on the boundary) of a jittered icosphere (the discrete H^2 < K at every
-vertex: the clamp), a bump and a saddle on 4 x 4 grids (open; H of both signs on the saddle) and a bipyramid whose
-M is barycentric (M is read, not rebuilt); its H mistakes are notebook 01's (``uniform.H_MISTAKES``).
+mesh and its angle deficits (NaN on the boundary): a jittered icosphere (the discrete H^2 < K at every vertex: the
+clamp), a bump and a saddle on 4 x 4 grids (open; H of both signs on the saddle) and a bipyramid (obtuse: mixed
+areas differ from barycentric ones). The answer builds the pair from the learner's own C (section 1) and mixed
+areas (section 2); the check asks those first (``result.earlier``), so a wrong one is named as the exercise to fix.
 """
 
 import numpy as np
+import scipy.sparse as sp
 
+from ...lessons.curvature import boundary_mask, gaussian_curvature, signed_mean_curvature
 from ...lessons.curvature import discrete_principal_curvatures as geomlib_principal
-from ...lessons.curvature import gaussian_curvature
 from ...lessons.laplace import cotangent_matrix as geomlib_cotangent_matrix
 from ...lessons.laplace import edge_lengths, laplacian
 from ...mesh.topology import boundary_edges
 from .area_mistakes import AREA_MISTAKES, RIGHT_AREAS
-from .catalogue import Case, Wrong, judge, mesh_cases, run, vector
+from .catalogue import Case, Wrong, agree, judge, mesh_cases, named, run, vector
 from .meshes import (
     bump_4x4,
     irregular_bipyramid,
@@ -28,8 +30,7 @@ from .meshes import (
     jittered_icosphere,
     obtuse_triangle,
 )
-from .result import Mistake, case_rng, exercise
-from .uniform import H_MISTAKES, mean_facts
+from .result import Mistake, case_rng, earlier, exercise
 
 __all__ = ["cotangent_matrix", "mixed_areas", "discrete_principal_curvatures"]
 
@@ -192,40 +193,67 @@ def _kappas(H, K, root=lambda d: np.sqrt(np.maximum(d, 0.0))):
     return np.stack([H + r, H - r])
 
 
-def principal_cases(rng):
+YOURS = ("my_cotangent_matrix", "my_mixed_areas")  # the learner's routines of sections 1 and 2
+
+
+def _differs(out, right):
+    try:
+        return not agree(
+            np.reshape(out.toarray() if hasattr(out, "toarray") else np.asarray(out, float), right.shape), right
+        )
+    except (TypeError, ValueError):
+        return True
+
+
+def principal_cases(rng, fn=None):
+    """The cases of ``discrete_principal_curvatures``, and whether the C and areas of ``fn``'s notebook are wrong."""
     meshes = (("a jittered icosphere", jittered_icosphere()), ("a bump on a 4 x 4 grid", bump_4x4()))
     meshes += (("a saddle on a 4 x 4 grid", jittered_grid_4x4()), ("an irregular bipyramid", irregular_bipyramid()))
     cases = []
-    for c, area in zip(mesh_cases(meshes, rng), ("mixed", "mixed", "mixed", "barycentric")):
-        M, C = laplacian(c.V, c.F, area=area)
-        deficit = gaussian_curvature(c.V, c.F, integrated=True)  # NaN on the boundary
-        case = Case(f"{c.label} with the {area} (M, C)", V=c.V, F=c.F, M=M, C=C, deficit=deficit)
+    for c in mesh_cases(meshes, rng):
+        (M, C), bary = laplacian(c.V, c.F, area="mixed"), laplacian(c.V, c.F)[0].diagonal()
+        A, deficit = M.diagonal(), gaussian_curvature(c.V, c.F, integrated=True)  # NaN on the boundary
         right = np.stack(geomlib_principal(c.V, c.F, M, C, deficit))
-        case = case.but(**mean_facts(c.V, c.F, M, C), K=deficit / M.diagonal(), kappas=right)
-        cases.append(case.but(where=np.isfinite(right), interior=np.isfinite(right)))
+        H_of = lambda areas, C=C, c=c: signed_mean_curvature(c.V, c.F, sp.diags(areas), C)  # noqa: E731
+        case = Case(c.label, V=c.V, F=c.F, deficit=deficit).but(C=C.toarray(), A=A, H=H_of(A), K=deficit / A)
+        case = case.but(H_I=H_of(np.ones(len(A))), H_inv=H_of(1 / A), H_bary=H_of(bary), bary=bary, kappas=right)
+        case = case.but(boundary=boundary_mask(c.V, c.F), where=np.isfinite(right), interior=np.isfinite(right))
+        yours = [
+            earlier(fn, YOURS[0], edge_lengths(c.V, c.F), c.F.copy()),
+            earlier(fn, YOURS[1], c.V.copy(), c.F.copy()),
+        ]
+        case = case.but(C_wrong=yours[0] is not None and _differs(yours[0], case.C))
+        case = case.but(A_wrong=yours[1] is not None and _differs(yours[1], A))
+        cases.append(case)
     return cases
 
 
-_RULE_K = "kappa_1,2 = H +- sqrt(max(H^2 - K, 0)), H_i = -1/2 <(M^-1 C x)_i, n_i>, K_i = deficit_i / M_ii"
+_RULE_K = "kappa_1,2 = H +- sqrt(max(H^2 - K, 0)), H = signed_mean_curvature(V, F, M, C), K_i = deficit_i / M_ii"
 _CLAMP = "clamp where the discrete H^2 < K: sqrt(max(H^2 - K, 0)), so that kappa_1 = kappa_2 = H there"
+_MIXED = "M = diag(my_mixed_areas(V, F)), the mixed areas of section 2, in H and in K"
+_EARLIER = "fix section {0} first: check.{1}({2}) names its mistake; then run this check again"
 # fmt: off
 KAPPA_MISTAKES = [
+    Wrong("your my_cotangent_matrix (section 1) returns a wrong C on {label}, and your kappas are built on it", _EARLIER.format(1, "cotangent_matrix", YOURS[0]), when=lambda k, right, c: c.C_wrong),
+    Wrong("your my_mixed_areas (section 2) returns wrong areas on {label}, and your kappas are built on them", _EARLIER.format(2, "mixed_areas", YOURS[1]), when=lambda k, right, c: c.A_wrong),
     Wrong("kappa_1 and kappa_2 are swapped: kappa_1 < kappa_2", "kappa_1 = H + sqrt(max(H^2 - K, 0)) is the larger", build=lambda c: c.kappas[::-1]),
     Wrong("K is the deficit itself, not divided by the area (integrated, not pointwise)", "the deficit is an angle (radians); K_i = deficit_i / M_ii is per unit area", build=lambda c: _kappas(c.H, c.deficit)),
     Wrong("H^2 - K is not clamped: its square root is NaN where the discrete H^2 < K", _CLAMP, build=lambda c: _kappas(c.H, c.K, np.sqrt)),
     Wrong("|H^2 - K| is used where the discrete H^2 < K, not the clamp to 0", _CLAMP, build=lambda c: _kappas(c.H, c.K, lambda d: np.sqrt(np.abs(d)))),
     Wrong("the square root is missing: H +- (H^2 - K)", _RULE_K, build=lambda c: _kappas(c.H, c.K, lambda d: np.maximum(d, 0.0))),
-    Wrong("the sign of H is lost: |H| drops the side the surface bends to", "H_i = -1/2 <(M^-1 C x)_i, n_i> is negative where the surface bends away from n_i", build=lambda c: _kappas(np.abs(c.H), c.K)),
-    Wrong("H is |M^-1 C x|: unsigned and without the 1/2", "H_i = -1/2 <(M^-1 C x)_i, n_i>", build=lambda c: _kappas(np.linalg.norm(c.DX, axis=1), c.K)),
-    Wrong("H is 1/2 |M^-1 C x| with a sign: the part of M^-1 C x along the surface is counted", "project onto the normal: H_i = -1/2 <(M^-1 C x)_i, n_i>", build=lambda c: _kappas(-0.5 * np.linalg.norm(c.DX, axis=1) * np.sign(np.einsum("ij,ij->i", c.DX, c.N)), c.K)),
-    *(Wrong(h.diagnosis, h.hint, build=lambda c, h=h: _kappas(h.build(c), c.K)) for h in H_MISTAKES if h.build is not None),
+    Wrong("the sign of H is lost: |H| drops the side the surface bends to", "signed_mean_curvature is negative where the surface bends away from the outward normal: keep its sign", build=lambda c: _kappas(np.abs(c.H), c.K)),
+    Wrong("H has the wrong sign: signed_mean_curvature already holds the -1/2 and the outward normal", "H = signed_mean_curvature(V, F, M, C) as it is (H > 0 on a sphere)", build=lambda c: _kappas(-c.H, c.K)),
+    Wrong("M is the identity in H: H is not divided by the vertex areas", _MIXED, build=lambda c: _kappas(c.H_I, c.K)),
+    Wrong("M is the identity: neither H nor K is divided by the vertex areas", _MIXED, build=lambda c: _kappas(c.H_I, c.deficit)),
+    Wrong("M holds the barycentric areas (a third of each triangle), not the mixed ones", _MIXED, build=lambda c: _kappas(c.H_bary, c.deficit / c.bary)),
+    Wrong("M^-1 is handed to signed_mean_curvature where M is asked for: H is multiplied by the areas, not divided", "signed_mean_curvature(V, F, M, C) divides by M itself: M = diag(areas)", build=lambda c: _kappas(c.H_inv, c.K)),
     Wrong("kappa_1 < kappa_2 at a vertex of {label}", "kappa_1 = H + sqrt(...) >= kappa_2 = H - sqrt(...)", when=lambda k, right, c: (k[0][c.where[0]] < k[1][c.where[0]]).any()),
     Wrong("kappa_1, kappa_2 differ from H +- sqrt(max(H^2 - K, 0)) at interior vertices of {label}", _RULE_K, typical=False),
 ]
 # fmt: on
 KAPPA_BOUNDARY = [
     Wrong(
-        "kappa_1, kappa_2 have values at boundary vertices, where the deficit (and so K) is NaN",
+        "kappa_1, kappa_2 have values at boundary vertices, where H and the deficit (and so K) are NaN",
         "let the NaN through: np.maximum and np.sqrt keep it (np.fmax, np.nan_to_num and a mask on H^2 < K do not)",
     ),
 ]
@@ -246,18 +274,17 @@ def _pair(out, n):
     "discrete_principal_curvatures",
     reread="section 5 · Principal curvatures",
     forbid=(
-        "lessons.curvature.discrete_principal_curvatures",
-        "lessons.curvature.principal_curvatures",
-        "lessons.curvature.signed_mean_curvature",
-        "lessons.curvature.mean_curvature",
-        "mesh.geometry.vertex_normals",
-        "mesh.geometry.face_normals",
+        *named("lessons.curvature", "mixed_principal_curvatures discrete_principal_curvatures principal_curvatures"),
+        *named("lessons.curvature", "mean_curvature"),
+        *named("lessons.laplace", "laplacian cotangent_matrix intrinsic_cotangent_matrix mixed_areas vertex_areas"),
     ),
-    own=("lessons.curvature.discrete_principal_curvatures", "lessons.curvature.principal_curvatures"),
+    own=named("lessons.curvature", "mixed_principal_curvatures discrete_principal_curvatures principal_curvatures"),
+    allow=("lessons.laplace.edge_lengths", "lessons.curvature.signed_mean_curvature"),
+    yours=YOURS,
 )
 def discrete_principal_curvatures(fn):
-    """Check ``fn(V, F, M, C, deficit) -> (kappa_1, kappa_2)``: H +- sqrt(max(H^2 - K, 0)), NaN on the boundary."""
-    cases = principal_cases(case_rng())
+    """Check ``fn(V, F, deficit) -> (kappa_1, kappa_2)``: your C and mixed areas, H +- sqrt(max(H^2 - K, 0))."""
+    cases = principal_cases(case_rng(), fn)
     answers = run(fn, cases, _pair)
     judge(KAPPA_MISTAKES, cases, answers, right=lambda c: c.kappas)
     judge(KAPPA_BOUNDARY, [c.but(where=~c.interior) for c in cases], answers, right=lambda c: c.kappas)

@@ -6,12 +6,15 @@ vertices (d = 357.1, mean edge 5.72, largest corner |max(V)| = 1,442 and 1 far a
 names are too) a standard deviation within 6 % of s passes; shared x, y, z are told by their correlation.
 
 ``denoising_metrics(fn)``: ``fn(V, V_clean, F) -> {"rms", "normal_mean", "volume_change"}``, geomlib's definitions
-(:mod:`geomlib.lessons.metrics`), each measure compared to 1e-6 of itself on two closed meshes.
+(:mod:`geomlib.lessons.metrics`), each measure compared to 1e-6 of itself on two closed meshes. The two volumes
+are handed out (:func:`geomlib.enclosed_volume`, written in notebook 06): the mistakes named are in the change.
 
-``denoising_experiment(fn)``: ``fn(V_clean, F, sigma, tau, iterations, seed) -> E``, noise, ``iterations`` implicit
-cotangent steps, E against the clean mesh. Any correct noise draw passes, so noisy runs on the shipped sphere
-(d = 139; E varies by about 1 % between draws) pass within 5 % of geomlib's; a run without noise (its E the
-shrinkage alone) is compared exactly and tells N iterations from N - 1 or N + 1.
+``denoising_experiment(fn)``: ``fn(V_clean, F, sigma, tau, iterations, seeds) -> (E_mean, E_std)``, per seed noise,
+``iterations`` implicit cotangent steps and E against the clean mesh; the mean and the sample standard deviation
+(ddof = 1) of the draws' E. One draw is ``seeds=(s, s)``: any correct noise draw passes, so noisy runs on the
+shipped sphere (d = 139; E varies by about 1 % between draws) pass within 5 % of geomlib's; a run without noise
+(its E the shrinkage alone) is compared exactly and tells N iterations from N - 1 or N + 1. Over three seeds the
+mean and spread are compared exactly with those of the learner's own draws, each run alone.
 
 ``denoising_sweep(fn)``: ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` on two noisy
 icospheres, every entry of the table exactly.
@@ -173,7 +176,7 @@ def _measure_cases():
             right=right, scale=np.abs(right), e2=np.sum((V - V_clean) ** 2, axis=1), d=bounding_box_diagonal(V_clean),
             d_noisy=bounding_box_diagonal(V), theta=theta, A_clean=np.linalg.norm(N_clean, axis=1) / 2, n=1,
             raw=np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", N, N_clean), -1, 1))), vol=t.sum(),
-            vol_clean=t_clean.sum(), unsigned=np.abs(t).sum(), unsigned_clean=np.abs(t_clean).sum()))  # fmt: skip
+            vol_clean=t_clean.sum()))  # fmt: skip
     return cases
 
 
@@ -202,17 +205,15 @@ MEASURE_MISTAKES = [
     _part(1, 'the angles are summed over the faces, not averaged', 'the mean over faces: every face counts once', lambda c: c.theta.sum()),
     _part(1, 'the mean angle is weighted by the face areas: every face counts once', 'np.mean over the faces, unweighted', lambda c: c.theta @ c.A_clean / c.A_clean.sum()),
     _part(2, 'the volume change is absolute (length^3), not relative', "divide vol - vol_clean by |vol_clean|", lambda c: c.vol - c.vol_clean),
-    _part(2, 'the volume change is absolute and the volumes lack the 1/6 of a tetrahedron', 'vol = sum_f x0 . (x1 x x2) / 6; then (vol - vol_clean) / |vol_clean|', lambda c: 6 * (c.vol - c.vol_clean)),
     _part(2, 'the volume change is divided by the new volume, not the clean one', '(vol - vol_clean) / |vol_clean|', lambda c: (c.vol - c.vol_clean) / c.vol),
     _part(2, 'this is the ratio vol / vol_clean, not the relative change', 'subtract 1: (vol - vol_clean) / |vol_clean|', lambda c: c.vol / c.vol_clean),
     _part(2, 'the sign of the volume change is flipped: a mesh that shrank must give a negative change', '(vol - vol_clean), not (vol_clean - vol)', lambda c: (c.vol_clean - c.vol) / c.vol_clean),
-    _part(2, "the tetrahedra's volumes are taken unsigned: the divergence theorem needs their signs", 'sum the signed x0 . (x1 x x2) / 6 (no abs): the parts outside the mesh cancel', lambda c: (c.unsigned - c.unsigned_clean) / c.unsigned_clean),
     Wrong('the measures differ from the right ones on {label}', 'E over the clean diagonal, the mean face-normal angle in degrees, the signed relative volume change', typical=False),
 ]
 # fmt: on
 
 
-@exercise("denoising_metrics", reread="section 3 · The measures, yours", forbid=_METRICS, own=named("lessons.metrics", "vertex_rms face_normal_angles volume_change"))  # fmt: skip
+@exercise("denoising_metrics", reread="section 3 · The measures, yours", forbid=_METRICS, own=named("lessons.metrics", "vertex_rms face_normal_angles volume_change"), allow=("mesh.geometry.enclosed_volume",))  # fmt: skip
 def denoising_metrics(fn):
     """Check ``fn(V, V_clean, F) -> {"rms": E, "normal_mean": degrees, "volume_change": signed fraction}``."""
     cases = _measure_cases()
@@ -227,7 +228,7 @@ def denoising_metrics(fn):
 # without noise exactly (1e-6: float32's rounding passes), which tells the iteration count.
 _SCALE, _SHIFT = 40.0, np.array([3.0, -2.0, 5.0])
 _EXP_SIGMA, _EXP_TAU_ELL2, _EXP_ITERATIONS, _EXP_SEED = 0.03, 0.2, 5, 11
-_EXP_TOLERANCE, _EXACT = 0.05, 1e-6
+_EXP_TOLERANCE, _EXACT, _SEEDS = 0.05, 1e-6, (11, 12, 13)
 
 
 @functools.lru_cache(maxsize=1)
@@ -263,7 +264,7 @@ def _experiment_cases():
     table = [("0 iterations (the noise itself)", 1.0, _EXP_SIGMA, 0), (f"{n} iterations", 1.0, _EXP_SIGMA, n)]
     table += [(f"no noise, {n} iterations", 1.0, 0.0, n), ("a tenth of the size (tau / 100)", 0.1, _EXP_SIGMA, n)]
     return [
-        Case(label, V=size * V, F=F, sigma=s, tau=size**2 * tau, iterations=k, seed=_EXP_SEED).but(
+        Case(label, V=size * V, F=F, sigma=s, tau=size**2 * tau, iterations=k, seeds=(_EXP_SEED, _EXP_SEED)).but(
             size=size, d=size * d, ell=size * ell, tau1=tau
         )
         for label, size, s, k in table
@@ -289,7 +290,7 @@ EXPERIMENT_MISTAKES = [
     _scalar('the noise is sqrt(3) too small (its square a third of the right one): each vertex moved by a random direction of length sigma * d, so each coordinate moves by only sigma * d / sqrt(3)', 'draw every coordinate with standard deviation sigma * d', lambda c: _e(c, directions=True)),
     _scalar('the error is measured against the noisy mesh (the input of the smoothing), not against the clean mesh, the truth', 'return the RMS distance between the smoothed mesh and V_clean', lambda c: _e(c, key='noisy')),
     _scalar('the error is measured against the noisy mesh W (as my_denoising_metrics(P, W, F)), not against the clean mesh, the truth', 'measure the smoothed mesh against V_clean: my_denoising_metrics(P, V_clean, F)', lambda c: _e(c, key='noisy d')),
-    _scalar('the error is that of the noisy mesh: the smoothed mesh is not the one measured', 'smooth the noisy mesh and measure the result against V_clean', lambda c: _e(c, key='noise')),
+    _scalar('the error is that of the noisy mesh (the mean over the noisy meshes): the smoothed mesh is not the one measured', 'smooth the noisy mesh and measure the result against V_clean', lambda c: _e(c, key='noise')),
     _scalar('the clean mesh was smoothed instead of the noisy one', 'smooth W = V_clean + noise, then compare with V_clean', lambda c: _e(c, sigma=0.0)),
     Wrong("on {label} the error differs from geomlib's run (by more than 5 %, or at all without noise)", 'smooth with geomlib.implicit_smoothing(W, F, tau, iterations) (cotangent weights)', typical=False),
 ]
@@ -300,26 +301,51 @@ def _same_e(a, r, c):
     return abs(a[0] - r[0]) <= (_EXACT if c.sigma == 0 else _EXP_TOLERANCE) * abs(r[0])
 
 
+def _pair(out):
+    if not isinstance(out, (tuple, list)) or len(out) != 2:
+        raise Mistake("the function did not return the pair (E_mean, E_std)", "end with `return E_mean, E_std`", typical=False)  # fmt: skip
+    return number(out[0], "E_mean"), number(out[1], "E_std")
+
+
+def _spread(m, s, c):
+    """(E_mean, E_std) on the scale of the learner's own draws' mean and standard deviation."""
+    return np.array([m / c.E.mean(), s / max(np.std(c.E, ddof=1), 1e-300)])
+
+
+# fmt: off
+SPREAD_MISTAKES = [
+    Wrong('the same seed made every draw (std 0): each draw takes its own seed', 'for seed in seeds: W = my_add_noise(V_clean, F, sigma, seed)', build=lambda c: _spread(c.E[0], 0.0, c)),
+    Wrong('the standard deviation is the population one (ddof = 0): the sample one divides by k - 1', 'np.std(E, ddof=1), k the number of seeds', build=lambda c: _spread(c.E.mean(), np.std(c.E), c)),
+    Wrong("the standard deviation is that of the noisy meshes' E, not of the smoothed ones'", 'collect E of the smoothed mesh P for every seed, then take its std', build=lambda c: _spread(c.E.mean(), np.std(c.E_noisy, ddof=1), c)),
+    Wrong('on {label} the mean or the std is not that of your own draws, each run alone', 'E_mean = np.mean(E), E_std = np.std(E, ddof=1), E one error per seed', typical=False),
+]
+# fmt: on
+
+
 @exercise(
     "denoising_experiment",
     reread="section 4 · The experiment, yours",
-    forbid=(*named("lessons.noise", "denoising_experiment add_noise"), *_METRICS, *_SWEEPS),
-    allow=("lessons.smoothing.implicit_smoothing",),
+    forbid=(*named("lessons.noise", "denoising_experiment denoising_spread add_noise"), *_METRICS, *_SWEEPS),
+    allow=("lessons.smoothing.implicit_smoothing", "mesh.geometry.enclosed_volume"),  # the latter in your measures
 )
 def denoising_experiment(fn):
-    """Check ``fn(V_clean, F, sigma, tau, iterations, seed) -> E`` (module docstring)."""
+    """Check ``fn(V_clean, F, sigma, tau, iterations, seeds) -> (E_mean, E_std)`` (module docstring)."""
     cases = _experiment_cases()
-    E = lambda c, **kw: number(answer(fn, c, **kw), hint="return the one relative error, a float")
+    E = lambda c, k=_EXP_SEED, **kw: _pair(answer(fn, c, seeds=(k, k), **kw))[0]  # one draw, seed k
     answers = [np.array([E(c)]) for c in cases]
     if not np.isclose(E(cases[1]), answers[1][0], rtol=1e-9, atol=0):
         raise Mistake(
-            "two calls with the same seed gave different errors: the noise is not seeded, so the experiment cannot be repeated",
-            "draw the noise from np.random.default_rng(seed)",
+            "two calls with the same seeds gave different errors: the noise is not seeded, so the experiment cannot be repeated",
+            "draw each noise with my_add_noise(V_clean, F, sigma, seed), seed from seeds",
         )
-    if E(cases[1], seed=_EXP_SEED + 1) == answers[1][0] and not np.isclose(answers[2][0], answers[1][0], rtol=1e-9):
-        raise Mistake("another seed gave the very same error: the seed is ignored", "pass seed to default_rng(seed)")
+    if E(cases[1], _EXP_SEED + 1) == answers[1][0] and not np.isclose(answers[2][0], answers[1][0], rtol=1e-9):
+        raise Mistake("other seeds gave the very same error: the seeds are ignored", "for seed in seeds: my_add_noise(V_clean, F, sigma, seed)")  # fmt: skip
     judge(EXPERIMENT_MISTAKES, cases, answers, right=lambda c: np.array([_e(c)]), same=_same_e)
-    return [f"a sphere of 2,562 vertices, d = 139: {', '.join(c.label for c in cases)}"]
+    c = Case(f"{cases[1].label} over the seeds {_SEEDS}", **{**cases[1].inputs, "seeds": _SEEDS}).but(**cases[1].facts)
+    c = c.but(E=np.array([E(c, k) for k in _SEEDS]), E_noisy=np.array([E(c, k, iterations=0) for k in _SEEDS]))
+    spread = _spread(*_pair(answer(fn, c)), c)
+    judge(SPREAD_MISTAKES, [c], [spread], right=lambda c: _spread(c.E.mean(), np.std(c.E, ddof=1), c))
+    return [f"a sphere of 2,562 vertices, d = 139, one draw: {', '.join(c.label for c in cases)}", c.label]  # fmt: skip
 
 
 # ------------------------------------------------------------------ the sweep over step and count
@@ -434,7 +460,7 @@ SWEEP_MISTAKES = [
         *_METRICS,
         *_SWEEPS,
     ),
-    allow=("lessons.laplace.laplacian",),
+    allow=("lessons.laplace.laplacian", "mesh.geometry.enclosed_volume"),  # the latter in your measures
 )
 def denoising_sweep(fn):
     """Check ``fn(W, F, V_clean, taus, iterations) -> (tau_best, N_best, E)`` (section 5 of notebook 07)."""

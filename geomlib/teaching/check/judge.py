@@ -1,11 +1,13 @@
 """The grading judge: each exercise's verdict, decided where the student's code cannot reach.
 
-``verdicts(nb, solution=None)`` starts a fresh judge process (``python -I -m
-geomlib.teaching.check.judge``) and returns, for each auto-graded exercise of the notebook
+``verdicts(nb, solution=None)`` asks the judge process (``python -I -m
+geomlib.teaching.check.judge``, started by the first call and kept for the next notebooks
+of the grading run) and returns, for each auto-graded exercise of the notebook
 ``nb`` (nbformat JSON), ``{"check": (passed, message), "partial_credit": (earned,
 message), "copies": [...]}``. The judge process holds the checks and their reference
-answers and never runs a line of the student's code: for each exercise it starts a
-``sandbox`` holding the notebook's imports and its solution cells, and hands the check a
+answers and never runs a line of the student's code: for each exercise it has a fresh
+``sandbox`` process (forked by the notebook's one ``Zygote``, which holds the notebook's
+imports) run the solution cells, and hands the check a
 ``Remote`` function that calls the student's function there through a pipe, with plain
 data (``wire``). A refusal reported by the sandbox (or its exit status 3) fails the check
 with no points, naming what it did. ``copies`` compares the exercise's functions with
@@ -18,11 +20,14 @@ does in the kernel.
 """
 
 import ast
-import json
+import atexit
 import os
 import select
+import signal
+import socket
 import subprocess
 import sys
+import tempfile
 
 from . import copies
 from .result import Refused, credit
@@ -31,49 +36,145 @@ from .wire import decode, encode, receive, send
 CALL_TIMEOUT = 600  # seconds a single call of the student's function may take (nbgrader's cells: Execute.timeout)
 
 
+_JUDGE = {}  # the judge process of this grading run, and its log: one nbgrader process grades notebook after notebook
+
+
 def verdicts(nb, solution=None, timeout=1800):
-    """The judge's verdicts on notebook ``nb`` (module docstring), from a fresh process."""
-    done = subprocess.run(
-        [sys.executable, "-I", "-m", "geomlib.teaching.check.judge"],
-        input=json.dumps({"notebook": nb, "solution": solution}),
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
-    )
-    if done.returncode != 0:
-        raise RuntimeError(f"the grading judge failed: {done.stderr[-2000:]}")
-    return json.loads(done.stdout.splitlines()[-1])
+    """The judge's verdicts on notebook ``nb`` (module docstring), from the judge process: a fresh one
+    the first time, kept for the next notebooks (it holds the checks, never a student's code)."""
+    judge = _JUDGE.get("process")
+    if judge is None or judge.poll() is not None:
+        log = _JUDGE["log"] = tempfile.TemporaryFile()
+        judge = _JUDGE["process"] = subprocess.Popen(
+            [sys.executable, "-I", "-m", "geomlib.teaching.check.judge"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=log,
+            env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
+        )
+        atexit.register(_end, judge)
+    try:
+        send(judge.stdin.fileno(), {"notebook": nb, "solution": solution})
+        found = receive(judge.stdout.fileno()) if select.select([judge.stdout], [], [], timeout)[0] else None
+    except OSError:
+        found = None
+    if found is None:
+        judge.kill()
+        judge.wait()
+        _JUDGE["log"].seek(0)
+        raise RuntimeError(f"the grading judge failed: {_JUDGE['log'].read().decode(errors='replace')[-2000:]}")
+    return found
+
+
+def _end(judge):
+    """End the judge process as the grading run ends (its stdin closed, it exits)."""
+    judge.stdin.close()
+    try:
+        judge.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        judge.kill()
+        judge.wait()
+
+
+class Zygote:
+    """The process that runs a notebook's imports once and forks each exercise's sandbox from there
+    (``sandbox.zygote``). Each sandbox is still a process of its own, started from the state a new
+    interpreter has after the imports, talking to the judge over pipes of its own; the zygote
+    only forks, and says over its socket which process it forked and how that process ended."""
+
+    def __init__(self, imports, cells, targets):
+        self.control, theirs = socket.socketpair()
+        self.process = subprocess.Popen(
+            [sys.executable, "-I", "-m", "geomlib.teaching.check.sandbox", str(theirs.fileno())],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            pass_fds=[theirs.fileno()],
+            env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
+        )
+        theirs.close()
+        send(self.control.fileno(), {"imports": imports, "cells": cells, "targets": targets})
+
+    def alive(self):
+        return self.process.poll() is None
+
+    def fork(self):
+        """(pid or None, fd writing to the new sandbox's stdin, fd reading its replies)."""
+        its_stdin, to_it = os.pipe()
+        from_it, its_replies = os.pipe()
+        try:
+            socket.send_fds(self.control, [b"fork"], [its_stdin, its_replies])
+            forked = receive(self.control.fileno())
+        except OSError:  # the zygote has ended: the pipes' other ends close with ours
+            forked = None
+        finally:
+            os.close(its_stdin)
+            os.close(its_replies)
+        return (forked or {}).get("forked"), to_it, from_it
+
+    def ended(self, timeout=30):
+        """The exit status of the sandbox forked last (it is killed after ``timeout`` seconds)."""
+        if not select.select([self.control], [], [], timeout)[0]:
+            return None
+        message = receive(self.control.fileno())
+        return None if message is None else message["ended"]
+
+    def close(self):
+        try:
+            socket.send_fds(self.control, [b"bye"], [])
+            self.process.wait(timeout=30)
+        except (OSError, subprocess.TimeoutExpired):
+            self.process.kill()
+            self.process.wait()
+        self.control.close()
 
 
 class Sandbox:
-    """A sandbox process holding one notebook's imports and solution cells (``sandbox``)."""
+    """One exercise's sandbox process, forked by the notebook's ``Zygote``, holding its solution cells."""
 
-    def __init__(self, plan):
-        self.process = subprocess.Popen(
-            [sys.executable, "-I", "-m", "geomlib.teaching.check.sandbox"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL,
-            env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
-        )
-        self.refusal, self.callables = None, []
-        send(self.process.stdin.fileno(), plan)
-        self.ready = self.answer()
+    def __init__(self, plan, zygote):
+        self.zygote, self.refusal, self.callables, self.status = zygote, None, [], None
+        self.pid, self.stdin, self.stdout = zygote.fork()
+        try:
+            send(self.stdin, plan)
+        except OSError:
+            pass  # it has ended already: its replies say so
+        try:
+            self.ready = self.answer()
+        except BaseException:
+            self._close_pipes()
+            raise
+
+    def wait(self):
+        """The sandbox process's exit status, once it has ended (killed if it does not end within 30 s)."""
+        if self.status is None:
+            status = self.zygote.ended() if self.zygote.alive() else None
+            if status is None and self.zygote.alive():
+                self.kill()
+                status = self.zygote.ended()
+            self.status = status if status is not None else -signal.SIGKILL
+        return self.status
+
+    def kill(self):
+        if self.pid is not None:
+            try:
+                os.kill(self.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
 
     def answer(self, timeout=CALL_TIMEOUT):
         """The sandbox's next reply; a refusal raises ``Refused``, an ended process ``Ended``."""
-        fd = self.process.stdout.fileno()
         while True:
-            if not select.select([fd], [], [], timeout)[0]:
-                self.process.kill()
+            if not select.select([self.stdout], [], [], timeout)[0]:
+                self.kill()
+                self.wait()
                 raise Ended(f"took longer than {timeout} s")
-            message = receive(fd)
+            message = receive(self.stdout)
             if message is None or "callback" not in message:
                 break
             self._call_back(message)
         if message is None or "hit" in message:
-            status = self.process.wait()
+            status = self.wait()
             if message is not None or status == 3:
                 message = message or {"hit": "fenced code", "why": ""}
                 self.refusal = Refused(message["hit"], message["why"])
@@ -88,26 +189,26 @@ class Sandbox:
             answer = {"ok": encode(self.callables[int(message["callback"])](*args))}
         except Exception as exc:  # noqa: BLE001 - the student's arguments may make the check's helper raise
             answer = {"raised": type(exc).__name__, "message": str(exc)[:500]}
-        send(self.process.stdin.fileno(), answer)
+        send(self.stdin, answer)
 
     def close(self):
         """End the sandbox; the refusal it reported while ending, if any."""
-        if self.process.poll() is None:
+        if self.status is None:
             try:
-                send(self.process.stdin.fileno(), {"bye": True})
-                leftover = receive(self.process.stdout.fileno())
+                send(self.stdin, {"bye": True})
+                leftover = receive(self.stdout)
             except OSError:
                 leftover = None
             if leftover is not None and "hit" in leftover:
                 self.refusal = Refused(leftover["hit"], leftover["why"])
-            try:
-                status = self.process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                status = self.process.wait()
-            if status == 3 and self.refusal is None:
+            if self.wait() == 3 and self.refusal is None:
                 self.refusal = Refused("fenced code")
+        self._close_pipes()
         return self.refusal
+
+    def _close_pipes(self):
+        for fd in (self.stdin, self.stdout):
+            os.close(fd)
 
 
 class Ended(Exception):
@@ -128,12 +229,19 @@ class Remote:
     def __init__(self, box, name):
         self.box, self.__name__ = box, name
 
+    def beside(self, name):
+        """The student's function ``name`` of the same notebook, called in the same sandbox (``result.earlier``)."""
+        return Remote(self.box, name)
+
     def __call__(self, *args):
         if self.box.refusal is not None:
             raise self.box.refusal
         self.box.callables = []
         sent = [encode(a, self.box.callables) for a in args]
-        send(self.box.process.stdin.fileno(), {"call": self.__name__, "args": sent})
+        try:
+            send(self.box.stdin, {"call": self.__name__, "args": sent})
+        except OSError:
+            pass  # the sandbox has ended: its replies say so
         reply = self.box.answer()
         if "raised" in reply:
             if reply["stub"]:
@@ -213,29 +321,36 @@ def judge_notebook(nb, solution=None):
     cells = solution_cells(nb)
     uses = bindings(nb)
     model = solution_cells(solution) if solution else {}
-    found = {}
-    for exercise, function in exercises(nb):
-        checker = getattr(check, exercise, None)
-        if checker is None:
-            continue
-        bound = {
-            name: ("student", fn) if found.get(ex, {}).get("passed") else ("reference", reference)
-            for name, (fn, ex, reference) in uses.items()
-            if ex in found
-        }
-        plan = {"imports": imports, "cells": list(cells.values()), "allow": list(checker.allow), "bindings": bound}
-        result = _decide(checker, plan, function)
-        flags = copies.exercise_copies(cells.get(exercise, ""), model.get(exercise, ""))
-        copied = [f for f in flags if f["of"] == "geomlib"]
-        if copied and result.written:
-            result = checker_result(checker, copies.refusal(copied[0]), result)
-        partial = credit(result)
-        found[exercise] = {
-            "passed": result.passed,
-            "check": [result.passed, f"{result.name}: {result.message}"],
-            "partial_credit": [partial.passed, f"{partial.name}: {partial.message}"],
-            "copies": flags,
-        }
+    targets = [name for fn, _, reference in uses.values() for name in (fn, reference)]
+    found, zygote = {}, None
+    try:
+        for exercise, function in exercises(nb):
+            checker = getattr(check, exercise, None)
+            if checker is None:
+                continue
+            if zygote is None or not zygote.alive():  # one per notebook; a new one should a sandbox end it
+                zygote = Zygote(imports, list(cells.values()), targets)
+            bound = {
+                name: ("student", fn) if found.get(ex, {}).get("passed") else ("reference", reference)
+                for name, (fn, ex, reference) in uses.items()
+                if ex in found
+            }
+            plan = {"cells": list(cells.values()), "allow": list(checker.allow), "bindings": bound}
+            result = _decide(checker, plan, function, zygote)
+            flags = copies.exercise_copies(cells.get(exercise, ""), model.get(exercise, ""))
+            copied = [f for f in flags if f["of"] == "geomlib"]
+            if copied and result.written:
+                result = checker_result(checker, copies.refusal(copied[0]), result)
+            partial = credit(result)
+            found[exercise] = {
+                "passed": result.passed,
+                "check": [result.passed, result.said],
+                "partial_credit": [partial.passed, partial.said],
+                "copies": flags,
+            }
+    finally:
+        if zygote is not None:
+            zygote.close()
     return found
 
 
@@ -246,10 +361,10 @@ def checker_result(checker, diagnosis, result):
     return CheckResult(result.name, False, f"{diagnosis} Reread {checker.reread}.", partial=False)
 
 
-def _decide(checker, plan, function):
+def _decide(checker, plan, function, zygote):
     box = None
     try:
-        box = Sandbox(plan)
+        box = Sandbox(plan, zygote)
         if "raised" in box.ready:
             raise Raised(box.ready["raised"], box.ready["message"])
         result = checker.evaluate(Remote(box, function))
@@ -276,9 +391,10 @@ def _failing(exc):
 
 
 def main():
-    request = json.loads(sys.stdin.read())
-    out = judge_notebook(request["notebook"], request.get("solution"))
-    print(json.dumps(out))
+    replies = os.dup(1)
+    os.dup2(os.open(os.devnull, os.O_WRONLY), 1)  # what a check prints stays out of the replies
+    while (request := receive(0)) is not None:
+        send(replies, judge_notebook(request["notebook"], request.get("solution")))
 
 
 if __name__ == "__main__":

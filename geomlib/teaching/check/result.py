@@ -56,6 +56,11 @@ page shows the diagnosis. Each exercise has two grade cells:
 ``use`` calls ``check.NAME.evaluate(fn)``, which never raises, so the cells after
 an exercise run on geomlib's own function in every mode.
 
+While graded, a check decides each function once: the first verdict on a function (its
+grade cell's) is the one its partial-credit cell, ``reveal`` and ``use`` read, as the
+grading judge derives partial credit from its one verdict per exercise; a reader's run
+draws fresh cases at every call.
+
 Ground rules
 ------------
 The ground rules are an allow-list (``fence``): an answer may use numpy and scipy
@@ -114,6 +119,7 @@ __all__ = [
     "close",
     "use",
     "reveal",
+    "earlier",
 ]
 
 
@@ -158,25 +164,35 @@ class CheckResult:
     message : str    what was checked (passed) or the diagnosis, hint and what to reread
     written : bool   False for a stub (the function raises NotImplementedError)
     partial : bool   passed, or failed by a typical mistake the check names (partial credit)
+    mark : str       the verdict's word: "passed" / "not yet" for a check; "earned" / "not earned"
+                     for partial credit, whose point a named mistake earns while its check says "not yet"
     """
 
-    def __init__(self, name, passed, message, written=True, partial=None):
+    def __init__(self, name, passed, message, written=True, partial=None, mark=None):
         self.name, self.passed, self.message = name, bool(passed), message
         self.written = bool(written)
         self.partial = self.passed if partial is None else bool(partial)
+        self.mark = mark or ("passed" if self.passed else "not yet")
 
     def __bool__(self):
         return self.passed
 
     def __repr__(self):
-        mark = "passed" if self.passed else "not yet"
-        return f"{self.name}: {mark}. {self.message}"
+        return f"{self.name}: {self.mark}. {self.message}"
+
+    @property
+    def said(self):
+        """The verdict as grading states it: ``NAME: MESSAGE`` for a check (a failure is its
+        diagnosis), ``NAME, partial credit: earned. MESSAGE`` or ``... not earned. ...`` for
+        partial credit, so that a grader reads a named mistake's point as earned, not as a pass."""
+        plain = self.mark in ("passed", "not yet")
+        return f"{self.name}: {self.message}" if plain else f"{self.name}: {self.mark}. {self.message}"
 
     def _repr_html_(self):
-        colour, mark = ("#1a7f37", "✔ passed") if self.passed else ("#b35900", "✘ not yet")
+        colour, sign = ("#1a7f37", "✔") if self.passed else ("#b35900", "✘")
         return (
             f'<div class="geomlib-check" style="border-left:4px solid {colour};padding:0.3em 0.8em">'
-            f'<b>{html.escape(self.name)}</b>: <b style="color:{colour}">{mark}</b>. '
+            f'<b>{html.escape(self.name)}</b>: <b style="color:{colour}">{sign} {self.mark}</b>. '
             f"{html.escape(self.message)}</div>"
         )
 
@@ -199,15 +215,17 @@ class Refused(Exception):
 class _Rules:
     """The ground rules of one exercise: an allow-list (the module docstring of ``fence``)."""
 
-    def __init__(self, forbid, own, allow=(), tools=("numpy", "scipy")):
+    def __init__(self, forbid, own, allow=(), tools=("numpy", "scipy"), yours=()):
         self.forbid, self.own, self.allow, self.tools = tuple(forbid), tuple(own), tuple(allow), tuple(tools)
+        self.yours = tuple(yours)
         self.fence = Fence(self.allow)
 
     def sentence(self):
         tools = list(self.tools)
         if self.allow:
             tools[-1:] = [tools[-1], "geomlib's " + _listed([f"`{_public(d)}`" for d in self.allow])]
-        return f"Ground rules: {_listed(tools)} only: no other geomlib routine, geometry library or copied code."
+        listed = _listed(tools) + (", and your own " + _listed([f"`{n}`" for n in self.yours]) if self.yours else "")
+        return f"Ground rules: {listed} only: no other geomlib routine, geometry library or copied code."
 
     def refusal(self, name, why=""):
         if why:
@@ -367,7 +385,7 @@ def _enforce(result):
     """``result``, or CheckFailed with its message: for any failure while nbgrader grades,
     for a written function's failure under the strict test run."""
     if not result.passed and (graded() or (strict_claims() and result.written)):
-        raise CheckFailed(f"{result.name}: {result.message}")
+        raise CheckFailed(result.said)
     return result
 
 
@@ -375,23 +393,34 @@ def _seed_said():
     return "" if _SEED["used"] is None else f" Cases seed {_SEED['used']}."
 
 
-def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy")):
+def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy"), yours=()):
     """Decorator making a check body into ``check(fn) -> CheckResult`` (see the module docstring).
 
     The ground rules are an allow-list: the answer may use ``tools`` and the geomlib
     routines ``allow`` names (dotted names inside geomlib); any other geomlib routine or a
     geometry library is refused. ``forbid``: the routines that would compute the answer,
     named in the rules' sentence; ``own``: those that are the exercise's own routine,
-    revealed by ``reveal`` (default: the first of ``forbid``).
+    revealed by ``reveal`` (default: the first of ``forbid``); ``yours``: the names of the
+    learner's routines of earlier exercises the answer builds on (``earlier`` looks them up).
     """
     overlap = set(forbid) & set(allow)
     if overlap:
         raise ValueError(f"exercise {name}: {sorted(overlap)} both forbidden and allowed")
-    rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools)
+    rules = _Rules(forbid, forbid[:1] if own is None else own, allow, tools, yours)
 
     def wrap(body):
+        decided = {}  # while graded: id(fn) -> (fn, its CheckResult), the first verdict on each function
+
         def evaluate(fn, seed=None):
-            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises."""
+            """The CheckResult of ``fn`` (its cases drawn with ``seed``, default a fresh one); never raises.
+            While graded, a function is decided once (module docstring)."""
+            if seed is not None or not graded():
+                return decide(fn, seed)
+            if id(fn) not in decided or decided[id(fn)][0] is not fn:
+                decided[id(fn)] = fn, decide(fn, seed)
+            return decided[id(fn)][1]
+
+        def decide(fn, seed):
             try:
                 _RULES[0] = rules
                 _SEED.update(asked=seed, used=None)
@@ -426,23 +455,45 @@ def exercise(name, reread, forbid=(), own=None, allow=(), tools=("numpy", "scipy
 
         check.exercise, check.reread = name, reread
         check.forbid, check.own, check.allow, check.rules = rules.forbid, rules.own, rules.allow, rules.sentence()
+        check.yours = rules.yours
         check.evaluate, check.partial_credit = evaluate, partial_credit
         return check
 
     return wrap
 
 
+def earlier(fn, name, *args):
+    """What the learner's routine ``name`` of an earlier exercise returns on ``args``, or None where there is
+    none, it is not written or it raises.
+
+    It is looked up where ``fn`` was written: the notebook's namespace (``fn.__globals__``) in
+    the kernel, the grading sandbox (``fn.beside(name)``: ``judge.Remote``) under nbgrader. A
+    check whose answer calls the learner's earlier routines asks them first, to say which
+    exercise to fix rather than blame the new one.
+    """
+    other = fn.beside(name) if hasattr(fn, "beside") else getattr(fn, "__globals__", {}).get(name)
+    if not callable(other):
+        return None
+    try:
+        return call(other, *args)
+    except (Mistake, _NotWritten):
+        return None
+
+
 def credit(result):
     """The partial-credit verdict on a check's ``result``: right, or a typical mistake the check names."""
     if result.passed:
-        message = "earned: the function passes its check."
+        mark, message = "earned", "the function passes its check."
     elif result.partial:
-        message = "earned: what is wrong is a typical mistake, named by the check above."
+        mark, message = (
+            "earned",
+            "what is wrong is a typical mistake, named by the check above; its fix earns the check's points.",
+        )
     elif not result.written:
-        message = result.message
+        mark, message = "not yet", result.message
     else:
-        message = f"not earned: the check cannot name what is wrong. {result.message}"
-    return CheckResult(f"{result.name}, partial credit", result.partial, message, written=result.written)
+        mark, message = "not earned", f"the check cannot name what is wrong. {result.message}"
+    return CheckResult(f"{result.name}, partial credit", result.partial, message, written=result.written, mark=mark)
 
 
 def use(fn, check, reference):

@@ -2,9 +2,14 @@
 
 ``judge`` starts it as ``python -I -m geomlib.teaching.check.sandbox`` (isolated: no
 current folder, no user site, no PYTHON* variables) and writes, as ``wire`` frames on its
-stdin, a plan: the notebook's import statements, the solution cells, the geomlib
-routines the exercise allows and the names the notebook's ``use`` cells bind. The sandbox
-imports, then *arms* and only then runs the solution cells; from there on, for good:
+stdin, the notebook's import statements, its solution cells and the names its ``use`` cells
+may bind. This first process, the *zygote*, runs the imports those cells and names need
+(not the notebook's plotting) and never the student's code. For each exercise the judge then
+writes a plan (the solution cells, the geomlib routines the exercise allows and the names the
+``use`` cells bind now) and the zygote forks a fresh process for it: that process starts from
+the state a new interpreter has after the imports (the imports are paid once per notebook,
+not once per exercise), *arms*, and only then runs the solution cells; from there on, for
+good:
 
 * the fence's profile (``fence.Fence.profile``) watches every call; an entry into fenced
   code (geomlib outside the allow-list, a geometry library) ends the process;
@@ -25,13 +30,16 @@ status 3 is a refusal even when the frame is lost.
 
 Then the sandbox answers ``{"call": name, "args": [...]}`` with ``{"ok": value, "args":
 [...after the call]}`` or ``{"raised": type, "message": ..., "stub": bool}``, and ``{"bye":
-true}`` by exiting with status 0. Student prints go to /dev/null; replies go to a
+true}`` by exiting with status 0. The forked process first says ``{"forked": pid}``, and the
+zygote says ``{"ended": status}`` when that process has ended, so the judge reads its exit status as
+it would a process of its own; ``{"bye": true}`` between exercises ends the zygote. Student prints go to /dev/null; replies go to a
 private copy of the original stdout.
 """
 
 import ast
 import importlib
 import os
+import socket
 import sys
 
 from .wire import decode, encode, receive, send
@@ -216,15 +224,52 @@ def _reference(ns, dotted):
 
 
 def main():
-    reply = os.dup(1)
-    quiet = os.open(os.devnull, os.O_WRONLY)
-    os.dup2(quiet, 1)
-    plan = receive(0)
-    fatal = _fatal_function(reply)
+    control = socket.socket(fileno=int(sys.argv[1]))
+    zygote(receive(control.fileno()), control)
+
+
+def imported(imports, needed):
+    """(namespace, None) after the notebook's import statements binding ``needed``, or (None, the exception)."""
     ns = {"__name__": "__main__"}
     try:
-        needed = names_used(plan["cells"]) | {target.partition(".")[0] for _, target in plan["bindings"].values()}
-        exec(compile(import_statements(plan["imports"], needed), "<the notebook's imports>", "exec"), ns)
+        exec(compile(import_statements(imports, needed), "<the notebook's imports>", "exec"), ns)
+    except BaseException as exc:  # noqa: BLE001 - reported as the cells' failure, as a compile error is
+        return None, exc
+    return ns, None
+
+
+def zygote(plan, control):
+    """Import once, then fork a fresh sandbox for each exercise (module docstring); never returns.
+
+    Each ``fork`` on the ``control`` socket brings the new process's two pipe ends (its stdin,
+    its replies); the process keeps only those, closes the socket and serves the exercise. The
+    zygote says ``{"forked": pid}`` and, once the process has ended, ``{"ended": status}``."""
+    ns, failed = imported(plan["imports"], names_used(plan["cells"]) | {t.partition(".")[0] for t in plan["targets"]})
+    while True:
+        word, fds, _, _ = socket.recv_fds(control, 16, 2)
+        if word != b"fork" or len(fds) != 2:
+            os._exit(0)
+        child = os.fork()
+        if child == 0:
+            try:
+                control.close()
+                os.dup2(fds[0], 0)
+                os.close(fds[0])
+                run(receive(0), None if ns is None else dict(ns), failed, fds[1])
+            finally:
+                os._exit(1)  # run ends the process itself; never back into this loop
+        for fd in fds:
+            os.close(fd)
+        send(control.fileno(), {"forked": child})
+        send(control.fileno(), {"ended": os.waitstatus_to_exitcode(os.waitpid(child, 0)[1])})
+
+
+def run(plan, ns, failed, reply):
+    """Compile the solution cells, arm, run them, bind the ``use`` names, and serve; never returns."""
+    fatal = _fatal_function(reply)
+    try:
+        if failed is not None:
+            raise failed
         cells = [compile(source, f"<solution cell {i + 1}>", "exec") for i, source in enumerate(plan["cells"])]
     except BaseException as exc:  # the student's cells do not compile: the judge says so
         send(reply, {"raised": type(exc).__name__, "message": str(exc), "stub": False, "setup": True})
