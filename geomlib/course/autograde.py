@@ -63,12 +63,20 @@ def _ensure_gradebook(course, assignment):
             ) from None
 
 
+#: Seconds a notebook's kernel may take to start. nbclient's default, 60 s, is for one kernel on
+#: a quiet machine; ``workers`` kernels start at once, and on a loaded 2-core machine one of
+#: them took longer, so a student's grading failed without a fault of theirs.
+KERNEL_START_SECONDS = 300
+KERNEL_START = f"--Execute.startup_timeout={KERNEL_START_SECONDS}"
+
+
 def autograde_class(course_dir, assignment, workers=1, students=None, force=False, out=print, extra_args=()):
     """Autograde every submitted student of ``assignment`` (or ``students``), ``workers`` at once.
 
     Returns the list of :class:`Graded`, in the order they finished; ``out`` receives one
     progress line per student. ``force`` regrades students already graded (nbgrader's
-    ``--force``); ``extra_args`` are passed on to every ``nbgrader autograde``.
+    ``--force``); ``extra_args`` are passed on to every ``nbgrader autograde``, after
+    ``--Execute.startup_timeout`` (:data:`KERNEL_START_SECONDS`), which they may override.
     """
     if workers < 1:
         raise ValueError(f"workers must be at least 1, not {workers}")
@@ -86,7 +94,7 @@ def autograde_class(course_dir, assignment, workers=1, students=None, force=Fals
         return []
     workers = min(workers, len(students))
     copies = workers > 1 and course.sqlite_file is not None
-    args = ["autograde", assignment, *(["--force"] if force else []), *extra_args]
+    args = ["autograde", assignment, *(["--force"] if force else []), KERNEL_START, *extra_args]
     total, finished, lock, start = len(students), [], threading.Lock(), time.perf_counter()
 
     with tempfile.TemporaryDirectory(prefix="geomlib-course-") as scratch:

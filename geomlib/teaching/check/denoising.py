@@ -149,7 +149,7 @@ def add_noise(fn):
 
 # ------------------------------------------------------------------ the measures
 # away from the origin (placed), closed: an icosphere with one vertex pulled out (74 of its 80 faces keep their
-# normal: an unclipped arccos meets a dot a rounding error above 1), a bipyramid shrunk and made noisy
+# normal: an unclipped arccos meets a dot a rounding error above 1), a bipyramid shrunk, noisy, an apex pushed through
 _KEYS = ("rms", "normal_mean", "volume_change")
 _METRICS = named("lessons.metrics", "denoising_metrics vertex_rms face_normal_angles volume_change MeshComparison")
 _SWEEPS = named("teaching.experiments.sweep", "smoothing_sweep denoising_comparison")
@@ -159,14 +159,18 @@ def _pulled(V, c, ell, rng):  # vertex 0 moved outwards: the volume grows
     return V + np.where(np.arange(len(V))[:, None] == 0, 0.4 * ell * (V[0] - c) / np.linalg.norm(V[0] - c), 0.0)
 
 
-def _shrunk(V, c, ell, rng):
+def _shrunk(
+    V, c, ell, rng
+):  # and its farthest vertex reflected through the middle: two or more faces turn over 90 degrees
+    far = np.argmax(np.linalg.norm(V - c, axis=1))
+    V = np.where(np.arange(len(V))[:, None] == far, c - (V - c), V)
     return c + 0.85 * (V - c) + rng.normal(scale=0.15 * ell, size=V.shape)
 
 
 def _measure_cases():
     rng, cases = case_rng(), []
     for label, mesh, move in (("an icosphere with one vertex pulled out", jittered_icosphere(), _pulled),
-                              ("a bipyramid shrunk and made noisy", irregular_bipyramid(), _shrunk)):  # fmt: skip
+                              ("a bipyramid shrunk, made noisy and an apex pushed through", irregular_bipyramid(), _shrunk)):  # fmt: skip
         V_clean, F = placed(*mesh, rng)
         V = move(V_clean, V_clean.mean(axis=0), mean_edge_length(V_clean, F), rng)
         (N, t), (N_clean, t_clean) = ((face_cross(X, F), face_volumes(X, F)) for X in (V, V_clean))
@@ -201,6 +205,7 @@ MEASURE_MISTAKES = [
     _part(0, 'E is not rooted (this is E^2)', 'take the square root of the mean of |x_i - x_i^clean|^2, then divide by d', lambda c: c.e2.mean() / c.d**2),
     _part(1, 'the mean angle is in radians, not degrees', 'np.degrees(angle)', lambda c: np.radians(c.theta.mean())),
     _part(1, 'the normals are not of unit length: arccos of the dot of two cross products is no angle', 'divide each cross product by its length before the dot product', lambda c: c.raw.mean()),
+    _part(1, 'the angles are folded to at most 90 degrees (arccos of |n . n_clean|): a face turned over is 180 degrees off, not 0', 'arccos of the clipped dot product itself, without its absolute value', lambda c: np.minimum(c.theta, 180 - c.theta).mean()),
     Wrong('the mean angle is NaN: arccos got a dot product above 1 (normals not of unit length, or a rounding error above 1)', 'normalise the normals and clip the dot product to [-1, 1] before arccos', when=lambda a, r, c: np.isnan(a[1])),
     _part(1, 'the angles are summed over the faces, not averaged', 'the mean over faces: every face counts once', lambda c: c.theta.sum()),
     _part(1, 'the mean angle is weighted by the face areas: every face counts once', 'np.mean over the faces, unweighted', lambda c: c.theta @ c.A_clean / c.A_clean.sum()),
@@ -326,6 +331,7 @@ SPREAD_MISTAKES = [
     "denoising_experiment",
     reread="section 4 · The experiment, yours",
     forbid=(*named("lessons.noise", "denoising_experiment denoising_spread add_noise"), *_METRICS, *_SWEEPS),
+    own=named("lessons.noise", "denoising_spread denoising_experiment"),
     allow=("lessons.smoothing.implicit_smoothing", "mesh.geometry.enclosed_volume"),  # the latter in your measures
 )
 def denoising_experiment(fn):
