@@ -790,6 +790,16 @@ def register_still(widget, shown):
     _SHOWN[widget.model_id] = shown
 
 
+def _shown_in(box):
+    """The views (registered with their still, text and summary) inside an ipywidgets box, at any depth, in order."""
+    shown = _SHOWN.get(getattr(box, "model_id", None))
+    if shown is not None:
+        yield shown
+        return
+    for child in getattr(box, "children", ()):
+        yield from _shown_in(child)
+
+
 def box_still(box):
     """Still picture of the views inside an ipywidgets box, or None if it holds none.
 
@@ -797,50 +807,18 @@ def box_still(box):
     its still picture; they are placed next to each other, (h, w, 3) uint8.
     Sliders and other controls are not drawn.
     """
-    images = []
-
-    def collect(widget):
-        shown = _SHOWN.get(getattr(widget, "model_id", None))
-        if shown is not None:
-            images.append(shown.still())
-            return
-        for child in getattr(widget, "children", ()):
-            collect(child)
-
-    collect(box)
+    images = [shown.still() for shown in _shown_in(box)]
     return in_a_row(images) if images else None
 
 
 def box_alt(box):
     """The text alternatives of the views inside an ipywidgets box, in one text ("" if it holds none)."""
-    texts = []
-
-    def collect(widget):
-        shown = _SHOWN.get(getattr(widget, "model_id", None))
-        if shown is not None:
-            texts.append(shown.alt_text())
-            return
-        for child in getattr(widget, "children", ()):
-            collect(child)
-
-    collect(box)
-    return " ".join(texts)
+    return " ".join(shown.alt_text() for shown in _shown_in(box))
 
 
 def box_text(box):
     """The summaries of the views (and figures) inside an ipywidgets box, one per line ("" if it holds none)."""
-    texts = []
-
-    def collect(widget):
-        shown = _SHOWN.get(getattr(widget, "model_id", None))
-        if shown is not None:
-            texts.append(shown.summary())
-            return
-        for child in getattr(widget, "children", ()):
-            collect(child)
-
-    collect(box)
-    return "\n".join(texts)
+    return "\n".join(shown.summary() for shown in _shown_in(box))
 
 
 def _box_png(box):
