@@ -157,7 +157,7 @@ def _scaled(a, b):
 
 # fmt: off
 POSITION_MISTAKES = [
-    Wrong('the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs', 'E^T M E = I, so the coefficients are E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: X)),
+    Wrong('the plain dot product E_k^T V is used where the M inner product E_k^T M V belongs', 'the basis is orthonormal in the M inner product of section 4: take the coefficients in that inner product', build=lambda c: _project(c, inner=lambda c, X: X)),
     Wrong('V is divided by the vertex areas (M^-1 V) instead of weighted by them (M V)', 'c = E_k^T M V', build=lambda c: _project(c, inner=lambda c, X: X / c.m[:, None])),
     Wrong('M multiplies the result (M E_k E_k^T V) instead of V inside the inner product', 'V_k = E_k (E_k^T (M V))', build=lambda c: _project(c, inner=lambda c, X: X, left=True)),
     Wrong('the constant eigenvector e_0 (lam = 0) is left out, so the shape is centred at the origin', 'use E[:, :k], e_0 included', build=lambda c: _project(c, first=1)),
