@@ -413,6 +413,37 @@ def test_each_exercise_is_judged_in_a_fresh_process_of_its_own():
     assert [found[e]["check"][0] for e in ("lam_max", "smoothing_loop")] == [True, True], found
 
 
+@pytest.mark.slow
+def test_one_zygote_serves_the_run_and_no_student_can_change_what_it_holds(monkeypatch):
+    # every student's sandboxes fork from the grading run's one zygote, which holds the solution
+    # notebook's imports: student A's import statements and what A's cells rebind in a module (here
+    # a module only A imports, and a mark on numpy) must not reach student B, graded after A
+    solution = nbformat.read(ROOT / "notebooks" / "05_explicit_smoothing.ipynb", as_version=4)
+    a, b = (nbformat.reads(nbformat.writes(solution), as_version=4) for _ in "ab")
+    a.cells.insert(1, nbformat.v4.new_code_cell("import wave"))
+    for cell in a.cells:
+        if cell.metadata.get("nbgrader", {}).get("grade_id") == "lam_max":
+            cell.source = "np.student_a = wave.WAVE_FORMAT_PCM\n\n" + cell.source
+    for cell in b.cells:
+        if cell.metadata.get("nbgrader", {}).get("grade_id") == "smoothing_loop":  # wrong, should it see A's traces
+            cell.source = cell.source.replace(
+                "    ### BEGIN SOLUTION\n",
+                "    ### BEGIN SOLUTION\n"
+                "    import sys\n"
+                "    if hasattr(np, 'student_a') or 'wave' in sys.modules:\n"
+                "        return V + 1.0\n",
+            )
+    started = []
+    zygote = judge.Zygote.__init__
+    monkeypatch.setattr(judge.Zygote, "__init__", lambda self: started.append(1) or zygote(self))
+    try:
+        found = [judge.judge_notebook(nb, solution) for nb in (a, b)]
+    finally:
+        judge.close_zygote()
+    assert len(started) == 1
+    assert [[v["check"][0] for v in verdicts.values()] for verdicts in found] == [[True, True], [True, True]], found
+
+
 def hand_in(course, student, notebooks, edit):
     """The released notebooks ``notebooks`` as ``student`` hands them in, each solution cell through ``edit``."""
     out = course / "submitted" / student / ASSIGNMENT

@@ -8,12 +8,13 @@ rewording its comments leaves the tree unchanged; writing it from the derivation
 gives the same tree, and a function under ``MIN_NODES`` nodes (a one-line answer) is
 never called a copy, because two honest students can write the same line.
 
-``find_copies(source, references)`` lists, for each function defined in ``source``, the
-reference functions with the same tree; ``exercise_copies`` is what the grading judge
+``find_copies(source, index(references))`` lists, for each function defined in ``source``,
+the reference functions with the same tree; ``exercise_copies`` is what the grading judge
 asks for one exercise: the exercise's solution cell against geomlib's own modules (a
-copy earns no points: ``refusal``) and against the solution notebook's cell (flagged for
-the grader). The solutions are public (the repository's notebooks/ is the solution
-version), so a flag is a question for the grader, not a verdict.
+copy earns no points: ``refusal``; their index, ``geomlib_index``, is made once per
+process) and against the solution notebook's cell (flagged for the grader). The solutions
+are public (the repository's notebooks/ is the solution version), so a flag is a question
+for the grader, not a verdict.
 """
 
 import ast
@@ -85,26 +86,35 @@ def functions(source):
     }
 
 
-def find_copies(source, references):
-    """[(function in source, reference label, reference function)] of the functions of ``source``
-    whose normalised tree is one of ``references`` ({label: source}) and has ``MIN_NODES`` nodes or more."""
-    index = {}
+def index(references):
+    """{normalised tree: (label, function)} of the functions of ``references`` ({label: source}) that have
+    ``MIN_NODES`` nodes or more (of equal trees, the first)."""
+    found = {}
     for label, text in references.items():
         for name, (tree, nodes) in functions(text).items():
             if nodes >= MIN_NODES:
-                index.setdefault(tree, (label, name))
-    return [(name, *index[tree]) for name, (tree, _) in functions(source).items() if tree in index]
+                found.setdefault(tree, (label, name))
+    return found
+
+
+def find_copies(source, references):
+    """[(function in source, reference label, reference function)] of the functions of ``source``
+    whose normalised tree is in ``references`` (an ``index``)."""
+    return [(name, *references[tree]) for name, (tree, _) in functions(source).items() if tree in references]
 
 
 @functools.cache
-def geomlib_sources():
-    """{module file: source} of geomlib's routines (lessons, mesh, numerics), read from the package folder."""
+def geomlib_index():
+    """The ``index`` of geomlib's routines (lessons, mesh, numerics), read from the package folder: made once
+    per process, since a grading run asks it for every exercise of every student."""
     root = Path(__file__).resolve().parents[2]
-    return {
-        path.relative_to(root.parent).with_suffix("").as_posix().replace("/", "."): path.read_text()
-        for folder in ("lessons", "mesh", "numerics")
-        for path in sorted((root / folder).glob("*.py"))
-    }
+    return index(
+        {
+            path.relative_to(root.parent).with_suffix("").as_posix().replace("/", "."): path.read_text()
+            for folder in ("lessons", "mesh", "numerics")
+            for path in sorted((root / folder).glob("*.py"))
+        }
+    )
 
 
 def exercise_copies(source, solution=""):
@@ -112,12 +122,12 @@ def exercise_copies(source, solution=""):
     ``of`` "geomlib" (a copy of geomlib's code: no points) or "solution" (flagged for the grader)."""
     flags = [
         {"function": name, "of": "geomlib", "matches": f"{label}.{ref}"}
-        for name, label, ref in find_copies(source, geomlib_sources())
+        for name, label, ref in find_copies(source, geomlib_index())
     ]
     if solution:
         flags += [
             {"function": name, "of": "solution", "matches": ref}
-            for name, _, ref in find_copies(source, {"solution": solution})
+            for name, _, ref in find_copies(source, index({"solution": solution}))
         ]
     return flags
 

@@ -5,14 +5,17 @@ geomlib.teaching.check.judge``, started by the first call and kept for the next 
 of the grading run) and returns, for each auto-graded exercise of the notebook
 ``nb`` (nbformat JSON), ``{"check": (passed, message), "partial_credit": (earned,
 message), "copies": [...]}``. The judge process holds the checks and their reference
-answers and never runs a line of the student's code: for each exercise it has a fresh
-``sandbox`` process (forked by the notebook's one ``Zygote``, which holds the notebook's
-imports) run the solution cells, and hands the check a
+answers and never runs a line of the student's code: for each exercise a fresh ``sandbox``
+process runs the student's import statements and solution cells, and the check gets a
 ``Remote`` function that calls the student's function there through a pipe, with plain
-data (``wire``). A refusal reported by the sandbox (or its exit status 3) fails the check
-with no points, naming what it did. ``copies`` compares the exercise's functions with
-geomlib's own code (a copy earns no points) and with the solution notebook's (flagged for
-the grader).
+data (``wire``). The sandboxes are forked by the grading run's one ``Zygote``, kept by the
+judge process from notebook to notebook and student to student: it imports what the solution
+notebook's import statements name (the lecturer's, never a student's: every later student's
+sandbox starts from it) and runs nothing else; without a solution notebook a zygote of the
+notebook's own serves it and ends with it. A refusal reported by the sandbox (or its exit
+status 3) fails the check with no points, naming what it did. ``copies`` compares the
+exercise's functions with geomlib's own code (a copy earns no points) and with the solution
+notebook's (flagged for the grader).
 
 The cells after an exercise see ``NAME = use(my_fn, check.X, reference)``: the sandbox binds
 NAME to the student's ``my_fn`` when the judge passed X, else to the reference, as ``use``
@@ -31,6 +34,7 @@ import tempfile
 
 from . import copies
 from .result import Refused, credit
+from .sandbox import import_statements, names_used
 from .wire import decode, encode, receive, send
 
 CALL_TIMEOUT = 600  # seconds a single call of the student's function may take (nbgrader's cells: Execute.timeout)
@@ -77,12 +81,13 @@ def _end(judge):
 
 
 class Zygote:
-    """The process that runs a notebook's imports once and forks each exercise's sandbox from there
+    """The process that holds the lecturer's imports and forks each exercise's sandbox from there
     (``sandbox.zygote``). Each sandbox is still a process of its own, started from the state a new
-    interpreter has after the imports, talking to the judge over pipes of its own; the zygote
-    only forks, and says over its socket which process it forked and how that process ended."""
+    interpreter has after those imports, talking to the judge over pipes of its own; the zygote
+    only imports what ``load`` names, forks, and says over its socket which process it forked and
+    how that process ended. It never runs a line of a student's notebook."""
 
-    def __init__(self, imports, cells, targets):
+    def __init__(self):
         self.control, theirs = socket.socketpair()
         self.process = subprocess.Popen(
             [sys.executable, "-I", "-m", "geomlib.teaching.check.sandbox", str(theirs.fileno())],
@@ -93,10 +98,22 @@ class Zygote:
             env={k: v for k, v in os.environ.items() if k not in ("NBGRADER_EXECUTION", "GEOMLIB_STRICT_CLAIMS")},
         )
         theirs.close()
-        send(self.control.fileno(), {"imports": imports, "cells": cells, "targets": targets})
+        self.loaded = set()
 
     def alive(self):
         return self.process.poll() is None
+
+    def load(self, statements):
+        """Have the zygote run the import ``statements`` (one a line) it has not run yet: every sandbox
+        forked after starts with those modules imported."""
+        new = [line for line in statements.splitlines() if line not in self.loaded]
+        if new:
+            try:
+                socket.send_fds(self.control, [b"load"], [])
+                send(self.control.fileno(), {"imports": new})
+            except OSError:
+                pass  # the zygote has ended: the next fork says so
+            self.loaded.update(new)
 
     def fork(self):
         """(pid or None, fd writing to the new sandbox's stdin, fd reading its replies)."""
@@ -121,7 +138,7 @@ class Zygote:
 
     def close(self):
         try:
-            socket.send_fds(self.control, [b"bye"], [])
+            socket.send_fds(self.control, [b"bye!"], [])
             self.process.wait(timeout=30)
         except (OSError, subprocess.TimeoutExpired):
             self.process.kill()
@@ -129,8 +146,28 @@ class Zygote:
         self.control.close()
 
 
+_ZYGOTE = {}  # the zygote of this grading run: every student's sandboxes fork from it
+
+
+def run_zygote(statements):
+    """The grading run's zygote, holding the lecturer's import ``statements`` (a new one should the last
+    have ended). What it holds depends on the solution notebooks alone, never on a student's."""
+    zygote = _ZYGOTE.get("zygote")
+    if zygote is None or not zygote.alive():
+        zygote = _ZYGOTE["zygote"] = Zygote()
+    zygote.load(statements)
+    return zygote
+
+
+def close_zygote():
+    """End the grading run's zygote (the judge process does so as the run ends)."""
+    zygote = _ZYGOTE.pop("zygote", None)
+    if zygote is not None:
+        zygote.close()
+
+
 class Sandbox:
-    """One exercise's sandbox process, forked by the notebook's ``Zygote``, holding its solution cells."""
+    """One exercise's sandbox process, forked by a ``Zygote``, holding the notebook's solution cells."""
 
     def __init__(self, plan, zygote):
         self.zygote, self.refusal, self.callables, self.status = zygote, None, [], None
@@ -311,31 +348,44 @@ def _text(cell):
     return cell["source"] if isinstance(cell["source"], str) else "".join(cell["source"])
 
 
+def needed_imports(nb):
+    """The import statements of ``nb`` (one a line) that bind a name its solution cells or ``use`` cells
+    read, wherever they are (a reference is imported where it is used); not the notebook's plotting."""
+    sources = [_text(c) for c in nb["cells"] if c["cell_type"] == "code" and not c.get("metadata", {}).get("nbgrader")]
+    targets = {name.partition(".")[0] for fn, _, reference in bindings(nb).values() for name in (fn, reference)}
+    return import_statements(sources, names_used(solution_cells(nb).values()) | targets)
+
+
 def judge_notebook(nb, solution=None):
-    """The verdicts (module docstring), in this process: the judge's side of ``verdicts``."""
+    """The verdicts (module docstring), in this process: the judge's side of ``verdicts``.
+
+    The sandboxes fork from the grading run's zygote, which imports what the solution notebook's
+    import statements name; each sandbox runs the student's own import statements itself. Without
+    a solution notebook, a zygote of this notebook's own, ended with it."""
     from geomlib.teaching import check
 
-    imports = [  # the notebook's import statements, wherever they are (a reference is imported where it is used)
-        _text(c) for c in nb["cells"] if c["cell_type"] == "code" and not c.get("metadata", {}).get("nbgrader")
-    ]
+    imports = needed_imports(nb)
     cells = solution_cells(nb)
     uses = bindings(nb)
     model = solution_cells(solution) if solution else {}
-    targets = [name for fn, _, reference in uses.values() for name in (fn, reference)]
-    found, zygote = {}, None
+    lecturers = needed_imports(solution) if solution else None
+    found, own = {}, None
     try:
         for exercise, function in exercises(nb):
             checker = getattr(check, exercise, None)
             if checker is None:
                 continue
-            if zygote is None or not zygote.alive():  # one per notebook; a new one should a sandbox end it
-                zygote = Zygote(imports, list(cells.values()), targets)
+            if lecturers is not None:
+                zygote = run_zygote(lecturers)
+            elif own is None or not own.alive():  # a new one should a sandbox end it
+                zygote = own = Zygote()
+                own.load(imports)
             bound = {
                 name: ("student", fn) if found.get(ex, {}).get("passed") else ("reference", reference)
                 for name, (fn, ex, reference) in uses.items()
                 if ex in found
             }
-            plan = {"cells": list(cells.values()), "allow": list(checker.allow), "bindings": bound}
+            plan = {"imports": imports, "cells": list(cells.values()), "allow": list(checker.allow), "bindings": bound}
             result = _decide(checker, plan, function, zygote)
             flags = copies.exercise_copies(cells.get(exercise, ""), model.get(exercise, ""))
             copied = [f for f in flags if f["of"] == "geomlib"]
@@ -349,8 +399,8 @@ def judge_notebook(nb, solution=None):
                 "copies": flags,
             }
     finally:
-        if zygote is not None:
-            zygote.close()
+        if own is not None:
+            own.close()
     return found
 
 
@@ -393,8 +443,11 @@ def _failing(exc):
 def main():
     replies = os.dup(1)
     os.dup2(os.open(os.devnull, os.O_WRONLY), 1)  # what a check prints stays out of the replies
-    while (request := receive(0)) is not None:
-        send(replies, judge_notebook(request["notebook"], request.get("solution")))
+    try:
+        while (request := receive(0)) is not None:
+            send(replies, judge_notebook(request["notebook"], request.get("solution")))
+    finally:
+        close_zygote()
 
 
 if __name__ == "__main__":

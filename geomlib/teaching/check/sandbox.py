@@ -1,15 +1,17 @@
 """The grading sandbox: a student's solution cells, run behind a fence they cannot switch off.
 
 ``judge`` starts it as ``python -I -m geomlib.teaching.check.sandbox`` (isolated: no
-current folder, no user site, no PYTHON* variables) and writes, as ``wire`` frames on its
-stdin, the notebook's import statements, its solution cells and the names its ``use`` cells
-may bind. This first process, the *zygote*, runs the imports those cells and names need
-(not the notebook's plotting) and never the student's code. For each exercise the judge then
-writes a plan (the solution cells, the geomlib routines the exercise allows and the names the
-``use`` cells bind now) and the zygote forks a fresh process for it: that process starts from
-the state a new interpreter has after the imports (the imports are paid once per notebook,
-not once per exercise), *arms*, and only then runs the solution cells; from there on, for
-good:
+current folder, no user site, no PYTHON* variables). This first process, the *zygote*, runs
+the import statements the judge hands it (``load``: the solution notebook's, those binding a
+name its solution cells or ``use`` cells read, not its plotting) in a namespace it throws
+away, and nothing else: it never runs the student's code, nor the student's imports. For each
+exercise the judge writes a plan (the student's import statements, the solution cells, the
+geomlib routines the exercise allows and the names the ``use`` cells bind now) and the zygote
+forks a fresh process for it: that process starts from the state a new interpreter has after
+the lecturer's imports (paid once per grading run, not once per exercise), runs the student's
+import statements in a fresh namespace (the modules already loaded: cheap), *arms*, and only
+then runs the solution cells. A fork copies the zygote's memory, so nothing a process does
+reaches the zygote or the processes forked after it. From arming on, for good:
 
 * the fence's profile (``fence.Fence.profile``) watches every call; an entry into fenced
   code (geomlib outside the allow-list, a geometry library) ends the process;
@@ -30,10 +32,10 @@ status 3 is a refusal even when the frame is lost.
 
 Then the sandbox answers ``{"call": name, "args": [...]}`` with ``{"ok": value, "args":
 [...after the call]}`` or ``{"raised": type, "message": ..., "stub": bool}``, and ``{"bye":
-true}`` by exiting with status 0. The forked process first says ``{"forked": pid}``, and the
-zygote says ``{"ended": status}`` when that process has ended, so the judge reads its exit status as
-it would a process of its own; ``{"bye": true}`` between exercises ends the zygote. Student prints go to /dev/null; replies go to a
-private copy of the original stdout.
+true}`` by exiting with status 0. The zygote says ``{"forked": pid}`` and, once that process
+has ended, ``{"ended": status}``, so the judge reads its exit status as it would a process of
+its own; ``bye!`` (or its socket closed) ends the zygote. Student prints go to /dev/null;
+requests come on the process's stdin, replies go to a pipe of its own.
 """
 
 import ast
@@ -224,29 +226,35 @@ def _reference(ns, dotted):
 
 
 def main():
-    control = socket.socket(fileno=int(sys.argv[1]))
-    zygote(receive(control.fileno()), control)
+    zygote(socket.socket(fileno=int(sys.argv[1])))
 
 
-def imported(imports, needed):
-    """(namespace, None) after the notebook's import statements binding ``needed``, or (None, the exception)."""
-    ns = {"__name__": "__main__"}
-    try:
-        exec(compile(import_statements(imports, needed), "<the notebook's imports>", "exec"), ns)
-    except BaseException as exc:  # noqa: BLE001 - reported as the cells' failure, as a compile error is
-        return None, exc
-    return ns, None
+def preload(statements):
+    """Run import ``statements`` in a namespace thrown away: their modules are then loaded (a statement that
+    fails is left to the sandbox's own import statements, which report it)."""
+    for statement in statements:
+        try:
+            exec(compile(statement, "<the imports a sandbox starts with>", "exec"), {"__name__": "__main__"})
+        except Exception:  # noqa: BLE001 - the sandbox running the same statement says what failed
+            pass
 
 
-def zygote(plan, control):
-    """Import once, then fork a fresh sandbox for each exercise (module docstring); never returns.
+def zygote(control):
+    """Fork a fresh sandbox for each exercise (module docstring); never returns.
 
-    Each ``fork`` on the ``control`` socket brings the new process's two pipe ends (its stdin,
-    its replies); the process keeps only those, closes the socket and serves the exercise. The
-    zygote says ``{"forked": pid}`` and, once the process has ended, ``{"ended": status}``."""
-    ns, failed = imported(plan["imports"], names_used(plan["cells"]) | {t.partition(".")[0] for t in plan["targets"]})
+    On the ``control`` socket, ``load`` and a frame ``{"imports": [statement, ...]}`` import modules
+    for the sandboxes forked after; each ``fork`` brings the new process's two pipe ends (its stdin,
+    its replies): the process keeps only those, closes the socket and serves the exercise. The
+    zygote says ``{"forked": pid}`` and, once the process has ended, ``{"ended": status}``. Anything
+    else (``bye!``, the socket closed) ends it."""
     while True:
-        word, fds, _, _ = socket.recv_fds(control, 16, 2)
+        word, fds, _, _ = socket.recv_fds(control, 4, 2)
+        if word == b"load" and not fds:
+            order = receive(control.fileno())
+            if order is None:
+                os._exit(0)
+            preload(order["imports"])
+            continue
         if word != b"fork" or len(fds) != 2:
             os._exit(0)
         child = os.fork()
@@ -255,7 +263,7 @@ def zygote(plan, control):
                 control.close()
                 os.dup2(fds[0], 0)
                 os.close(fds[0])
-                run(receive(0), None if ns is None else dict(ns), failed, fds[1])
+                run(receive(0), fds[1])
             finally:
                 os._exit(1)  # run ends the process itself; never back into this loop
         for fd in fds:
@@ -264,14 +272,15 @@ def zygote(plan, control):
         send(control.fileno(), {"ended": os.waitstatus_to_exitcode(os.waitpid(child, 0)[1])})
 
 
-def run(plan, ns, failed, reply):
-    """Compile the solution cells, arm, run them, bind the ``use`` names, and serve; never returns."""
+def run(plan, reply):
+    """Run the notebook's import statements in a fresh namespace, compile the solution cells, arm, run
+    them, bind the ``use`` names, and serve; never returns."""
     fatal = _fatal_function(reply)
+    ns = {"__name__": "__main__"}
     try:
-        if failed is not None:
-            raise failed
+        exec(compile(plan["imports"], "<the notebook's imports>", "exec"), ns)
         cells = [compile(source, f"<solution cell {i + 1}>", "exec") for i, source in enumerate(plan["cells"])]
-    except BaseException as exc:  # the student's cells do not compile: the judge says so
+    except BaseException as exc:  # the imports fail or the student's cells do not compile: the judge says so
         send(reply, {"raised": type(exc).__name__, "message": str(exc), "stub": False, "setup": True})
         os._exit(0)
     _arm(ns, plan["allow"], fatal, cells)
