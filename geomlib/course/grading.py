@@ -34,6 +34,7 @@ from nbgrader.coursedir import CourseDirectory
 from nbgrader.preprocessors import NbGraderPreprocessor
 from traitlets import Bool
 
+from ..teaching.check import CheckFailed
 from ..teaching.check.copies import flag_sentence
 from ..teaching.check.judge import verdicts
 from .model_answers import model_answers
@@ -118,7 +119,10 @@ def _outputs(passed, message, flags):
             "error",
             ename="CheckFailed",
             evalue=message,
-            traceback=[f"CheckFailed: {message}", *([flagged] if flagged else [])],
+            traceback=[
+                *CheckFailed(message)._render_traceback_(),
+                *([flagged] if flagged else []),
+            ],  # as the kernel shows it
         )
     ]
 
