@@ -1,12 +1,15 @@
 """Autograde seconds per student of the seven exercise notebooks, against the floor.
 
-    python benchmarks/bench_autograde.py [--students 2] [--workers 2] [--json out.json] [--no-judge]
+    python benchmarks/bench_autograde.py [--students 10] [--workers 2] [--json out.json] [--no-judge]
 
 Builds a course folder in a temporary directory (notebooks 01-07 as one assignment,
 ``nbgrader generate_assignment``), configured as docs/grading.md configures a course (the
 grading judge's preprocessor included; ``--no-judge`` leaves it out, as the figures before
 it were measured), hands in ``--students`` full solutions, and measures in one run, so that
-the machine's load moves every figure alike:
+the machine's load moves every figure alike. Each grading run starts with an empty cache
+folder (``GEOMLIB_CACHE_DIR``), so what a class pays once (the model answers from one run of
+the solution notebooks, ``geomlib.course.model_answers``) is in its figure, shared by the
+class: the default of 10 students is a small class.
 
 * the floor: for each notebook, a fresh kernel started by nbclient (as nbgrader's Execute
   does) running one cell with every import the notebook makes, summed over the seven;
@@ -111,7 +114,7 @@ def make_course(folder, students, judge=True):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--students", type=int, default=2)
+    parser.add_argument("--students", type=int, default=10)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", type=Path)
     parser.add_argument("--no-judge", action="store_true", help="grade without the grading judge (docs/grading.md)")
@@ -126,10 +129,12 @@ def main(argv=None):
             (serial / "nbgrader_config.py").read_text().replace(str(serial), str(parallel))
         )
         floor_before, floor_cpu_before = floor_seconds()
+        os.environ["GEOMLIB_CACHE_DIR"] = str(Path(scratch) / "cache-serial")
         began, cpu = time.perf_counter(), cpu_seconds()
         nbgrader(serial, "autograde", ASSIGNMENT)
         serial_s = (time.perf_counter() - began) / args.students
         serial_cpu = (cpu_seconds() - cpu) / args.students
+        os.environ["GEOMLIB_CACHE_DIR"] = str(Path(scratch) / "cache-parallel")
         began = time.perf_counter()
         graded = autograde_class(parallel, ASSIGNMENT, workers=args.workers, out=print)
         parallel_s = (time.perf_counter() - began) / args.students

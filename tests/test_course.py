@@ -411,3 +411,24 @@ def test_the_syllabus_feedback_sample_is_what_the_check_says(monkeypatch):
     shown = [line for line in sample.splitlines() if line and not line.startswith("check.")]
     seedless = lambda lines: [re.sub(r"seed \d+", "seed N", line) for line in lines]
     assert seedless(shown) == seedless(said)
+
+
+def test_model_answers_come_from_one_run_of_the_solution_and_are_read_back(tmp_path, monkeypatch):
+    from geomlib.course import model_answers as answers
+
+    nb = nbformat.v4.new_notebook()
+    lesson = nbformat.v4.new_code_cell("import os\nn = 6 * 7")
+    answer = nbformat.v4.new_code_cell("print(f'Rubric (3 points): {n}', os.environ['NBGRADER_EXECUTION'])")
+    answer.metadata["nbgrader"] = {"grade": True, "grade_id": "q_model_answer", "locked": True, "points": 0}
+    nb.cells = [lesson, answer]
+    path = tmp_path / "solution.ipynb"
+    nbformat.write(nb, path)
+    monkeypatch.delenv("NBGRADER_EXECUTION", raising=False)
+    first = answers.model_answers(path, cache_dir=tmp_path / "cache" / "eigenbases")
+    assert [o["text"] for o in first["q_model_answer"]] == ["Rubric (3 points): 42 autograde\n"]
+    monkeypatch.setattr(answers, "_run", lambda path: pytest.fail("ran the notebook again"))
+    assert answers.model_answers(path, cache_dir=tmp_path / "cache" / "eigenbases") == first
+    nbformat.write(nbformat.v4.new_notebook(cells=[answer]), path)  # another notebook: run anew
+    monkeypatch.undo()
+    again = answers.model_answers(path, cache_dir=tmp_path / "cache" / "eigenbases")
+    assert again["q_model_answer"][0]["output_type"] == "error"  # n is the lesson's, not there

@@ -9,8 +9,8 @@ uniform Laplacian). One ``autograde`` grades them all: the auto-graded points
 are scored, the hand-graded discussion waits as "needs manual grade" until a
 grader enters points; ``export`` writes the CSV; ``validate`` fails on the stubs,
 naming the exercises, and passes on a full solution; ``generate_feedback`` writes
-pages whose 3D views are pictures and whose failed grade cell shows the check's
-diagnosis.
+pages showing the student's code, the grading judge's verdict in each grade cell (a
+failed one with the check's diagnosis) and the lesson's cells set aside, unrun.
 """
 
 import csv
@@ -24,7 +24,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from geomlib.course.grading import CONFIG_LINE
+from geomlib.course.grading import CONFIG_LINE, SET_ASIDE
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
@@ -239,28 +239,40 @@ def model_answers(path):
     return [grade_id for grade_id in ids if grade_id.endswith("_model_answer")]
 
 
-def view_outputs(nb):
-    """Outputs of a notebook that show a 3D view (a MeshView, a side_by_side row or a box of views)."""
-    for cell in nb["cells"]:
-        for out in cell.get("outputs", []):
-            text = "".join(out.get("data", {}).get("text/plain", ""))
-            if text.startswith("MeshView:") or text.startswith("still picture of the 3D views"):
-                yield out
+def ran(cell):
+    """Whether the kernel ran a cell while grading (nbclient records when it started it)."""
+    return "iopub.execute_input" in cell.get("metadata", {}).get("execution", {})
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("student", ("stubs", "solved", "one_mistake"))
-def test_feedback_pages_show_every_view_as_its_text_and_the_diagnosis(course, student):
-    # a grading run draws no picture: a view gives its summary, a figure its alt text
+def test_feedback_pages_show_the_judges_verdicts_and_the_students_code_with_the_lesson_set_aside(course, student):
+    # the kernel runs the first cell, the parameters and the solution cells; the judge fills the grade cells
     for name in GRADED.values():
         nb = json.loads((course / "autograded" / student / ASSIGNMENT / f"{name}.ipynb").read_text())
-        views = list(view_outputs(nb))
-        assert views, f"{name}: no 3D view found"
-        assert all(set(out["data"]) == {"text/plain"} for out in views)
-        assert not any("image/png" in out.get("data", {}) for c in nb["cells"] for out in c.get("outputs", []))
+        code = [c for c in nb["cells"] if c["cell_type"] == "code"]
+        for i, cell in enumerate(code):
+            info = cell["metadata"].get("nbgrader", {})
+            kernel = i == 0 or "parameters" in cell["metadata"].get("tags", []) or info.get("solution")
+            assert ran(cell) == bool(kernel and not info.get("grade")), (name, cell["source"][:80])
+        ids = [c["metadata"].get("nbgrader", {}).get("grade_id", "") for c in code]
+        judged = [c for c, g in zip(code, ids) if g.endswith(("_check", "_partial_credit"))]
+        assert judged and all(not ran(c) and c["outputs"] for c in judged)
+        # the rubric and the model answer with the lesson's numbers, from one run of the course's solution
+        answers = [c for c, g in zip(code, ids) if g.endswith("_model_answer")]
+        assert answers and all(not ran(c) for c in answers)
+        assert all("Rubric (" in "".join(o["data"]["text/markdown"]) for c in answers for o in c["outputs"]), name
+        noted = [
+            c for c in code if any(SET_ASIDE in "".join(o.get("data", {}).get("text/plain", "")) for o in c["outputs"])
+        ]
+        assert len(noted) == 1 and not ran(noted[0])
+        lesson = [c for c in code if not ran(c) and c not in judged + answers and c is not noted[0]]
+        assert lesson and not any(c["outputs"] for c in lesson)
         page = (course / "feedback" / student / ASSIGNMENT / f"{name}.html").read_text()
         assert "widget-view+json" not in page and "data:image/png;base64," not in page
-        assert "MeshView: " in page and "Figure: " in page
+        passed = page.count("(decided by the grading judge)")
+        wrong = student == "stubs" or (student == "one_mistake" and name == GRADED["01"])
+        assert passed < len(judged) if wrong else passed == len(judged)
         assert (DIAGNOSIS in page) == (student == "one_mistake" and name == GRADED["01"])
         if student == "stubs":
             assert page.count("not written yet") >= 4  # each exercise's two grade cells

@@ -81,8 +81,8 @@ In the notebook the learner's function runs in the learner's kernel, so the chec
 ``sys.setprofile``/``sys.settrace``, tripwires on libigl's compiled routines) is the
 student's interactive check: fast, with the same diagnoses, but code in the kernel can
 replace the check, its module or numpy. Under nbgrader the points are decided out of the
-kernel's reach: the preprocessor ``geomlib.course.grading.JudgeExercises`` runs after
-the notebook executed and hands each exercise to ``judge``, a fresh process holding the
+kernel's reach: the preprocessor ``geomlib.course.grading.JudgeExercises`` runs in
+nbgrader's process before the kernel starts and hands each exercise to ``judge``, a fresh process holding the
 check and its reference answers, which calls the student's function in a ``sandbox``
 process through a pipe carrying plain data (arrays, sparse matrices as their components,
 sympy as its srepr). The sandbox runs only the notebook's imports and the solution cells,
