@@ -18,13 +18,16 @@ import scipy.sparse as sp
 import trimesh
 
 import geomlib
+import geomlib.lessons.filters as filters
 import geomlib.lessons.smoothing as smoothing
 import geomlib.lessons.spectral as spectral
 import geomlib.lessons.symbolic as symbolic
 import geomlib.numerics.eigen as eigen
 from geomlib import check
-from geomlib.lessons.laplace import intrinsic_cotangent_matrix, voronoi_pieces
+from geomlib.lessons.laplace import FaceGeometry, face_geometry, intrinsic_cotangent_matrix, voronoi_pieces
+from geomlib.mesh.topology import edges
 from geomlib.numerics.eigen import largest_eigenpair
+from geomlib.teaching.check.fence import Fence
 from geomlib.teaching.check.result import reveal
 
 SHORTCUTS = {
@@ -127,6 +130,45 @@ def test_a_call_hidden_in_a_helper_is_still_seen():
 
     result = check.uniform_laplacian.evaluate(answer)  # the first routine entered is named
     assert not result.passed and "`mean_curvature`" in result.message
+
+
+# the ways into fenced code an answer might take: (answer of (V, F), the entry the fence must name)
+WAYS_IN = {
+    "a direct call": (lambda V, F: edges(F), "geomlib's `edges`"),
+    "a lambda": (lambda V, F: (lambda G: edges(G))(F), "geomlib's `edges`"),
+    "geomlib's generator, resumed": (lambda V, F: next(FaceGeometry.blocks(V, F)), "geomlib's `FaceGeometry.blocks`"),
+    "geomlib's routine as numpy's callback": (
+        lambda V, F: np.apply_along_axis(filters.mode_factor, 0, np.ones(3), 0.1, "explicit"),
+        "geomlib's `mode_factor`",
+    ),
+    "a geometry library": (lambda V, F: trimesh.triangles.area(V[F]), "trimesh's `area`"),
+}
+
+
+def fence_hits(answer, allow=()):
+    """The entries the fence names while ``answer`` runs on a tetrahedron (the fence as the checks arm it)."""
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    hits = []
+    import sys
+
+    sys.setprofile(Fence(allow).profile(hits.append))
+    try:
+        answer(V, F)
+    finally:
+        sys.setprofile(None)
+    return hits
+
+
+@pytest.mark.parametrize("way", sorted(WAYS_IN))
+def test_the_fence_names_every_way_into_fenced_code(way):
+    answer, named = WAYS_IN[way]
+    assert fence_hits(answer)[:1] == [named]
+
+
+def test_the_fence_lets_an_allowed_routine_use_its_helpers_and_numpy_pass():
+    assert fence_hits(lambda V, F: face_geometry(V, F), allow=("lessons.laplace.face_geometry",)) == []
+    assert fence_hits(lambda V, F: np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]))) == []
 
 
 def power_iteration(M, C):

@@ -121,6 +121,7 @@ class Fence:
             arg,
             allowed=self.allowed(),
             libraries=tuple(self.libraries.items()),
+            fenced=(_GEOMLIB, *self.libraries),
             on_hit=on_hit,
             geomlib=_GEOMLIB,
             checks=_CHECKS,
@@ -128,8 +129,11 @@ class Fence:
         ):
             if event != "call":
                 return
-            code, caller = frame.f_code, frame.f_back
+            code = frame.f_code
             name = code.co_filename
+            if not name.startswith(fenced):  # neither geomlib's nor a geometry library's file: most calls, one test
+                return
+            caller = frame.f_back
             where = "" if caller is None else caller.f_code.co_filename
             inside = where.startswith(geomlib) and not where.startswith(checks)
             if name.startswith(geomlib) and not name.startswith(checks):
