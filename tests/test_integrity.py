@@ -502,10 +502,11 @@ def scores(course):
 
 
 def grade_cell_outputs(course, student, nb_id, exercise):
+    """The texts under the exercise's two grade cells, each on one line (a verdict is wrapped as the kernel wraps it)."""
     nb = nbformat.read(course / "autograded" / student / ASSIGNMENT / f"{NOTEBOOKS[nb_id]}.ipynb", as_version=4)
     cells = {c.metadata.get("nbgrader", {}).get("grade_id"): c for c in nb.cells}
     return [
-        "\n".join(o.get("traceback", [])) if o.output_type == "error" else o.data["text/plain"]
+        " ".join(("\n".join(o.get("traceback", [])) if o.output_type == "error" else o.data["text/plain"]).split())
         for part in ("_check", "_partial_credit")
         for o in cells[exercise + part].outputs
     ]
