@@ -415,9 +415,9 @@ def test_each_exercise_is_judged_in_a_fresh_process_of_its_own():
 
 @pytest.mark.slow
 def test_one_zygote_serves_the_run_and_no_student_can_change_what_it_holds(monkeypatch):
-    # every student's sandboxes fork from the grading run's one zygote, which holds the solution
-    # notebook's imports: student A's import statements and what A's cells rebind in a module (here
-    # a module only A imports, and a mark on numpy) must not reach student B, graded after A
+    # every student's sandboxes, notebook after notebook, fork from the grading run's one zygote, which
+    # holds the solution notebooks' imports: student A's import statements and what A's cells rebind
+    # in a module (here a module only A imports, and a mark on numpy) must not reach student B
     solution = nbformat.read(ROOT / "notebooks" / "05_explicit_smoothing.ipynb", as_version=4)
     a, b = (nbformat.reads(nbformat.writes(solution), as_version=4) for _ in "ab")
     a.cells.insert(1, nbformat.v4.new_code_cell("import wave"))
@@ -433,15 +433,16 @@ def test_one_zygote_serves_the_run_and_no_student_can_change_what_it_holds(monke
                 "    if hasattr(np, 'student_a') or 'wave' in sys.modules:\n"
                 "        return V + 1.0\n",
             )
+    implicit = nbformat.read(ROOT / "notebooks" / "06_implicit_smoothing.ipynb", as_version=4)  # B's next notebook
     started = []
     zygote = judge.Zygote.__init__
     monkeypatch.setattr(judge.Zygote, "__init__", lambda self: started.append(1) or zygote(self))
     try:
-        found = [judge.judge_notebook(nb, solution) for nb in (a, b)]
+        found = [judge.judge_notebook(nb, model) for nb, model in ((a, solution), (b, solution), (implicit, implicit))]
     finally:
         judge.close_zygote()
     assert len(started) == 1
-    assert [[v["check"][0] for v in verdicts.values()] for verdicts in found] == [[True, True], [True, True]], found
+    assert [[v["check"][0] for v in verdicts.values()] for verdicts in found] == [[True, True]] * 3, found
 
 
 def hand_in(course, student, notebooks, edit):
