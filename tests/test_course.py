@@ -406,7 +406,8 @@ def test_the_syllabus_feedback_sample_is_what_the_check_says(monkeypatch):
     with pytest.raises(Exception) as failed:
         check.uniform_laplacian(namespace["my_uniform_laplacian"])
     partial = check.uniform_laplacian.partial_credit(namespace["my_uniform_laplacian"])
-    said = [*failed.value._render_traceback_(), f"{partial!r} (decided by the grading judge)"]  # as the judge writes it
+    judge = "(decided by the grading judge)"  # as the judge writes it
+    said = [*failed.value._render_traceback_(), judge, f"{partial!r} {judge}"]
     (sample,) = re.findall(r"```text\n(.*?)```", (ROOT / "docs" / "syllabus.md").read_text(), flags=re.S)
     shown = [line for line in sample.splitlines() if line and not line.startswith("check.")]
     seedless = lambda lines: [re.sub(r"seed \d+", "seed N", line) for line in lines]

@@ -393,6 +393,26 @@ def test_the_judge_finds_the_earlier_routine_an_answer_builds_on_in_the_sandbox(
 
 
 @pytest.mark.slow
+def test_a_solution_cell_that_raises_costs_only_what_it_did_not_define():
+    """As in a kernel, a cell stops at its error and the next cells still run. Grading runs the
+    solution cells without the lesson's variables: a trial call on the lesson's mesh after the
+    function costs nothing; an error before a function's definition fails that exercise only,
+    saying which cell raised and why."""
+    nb = nbformat.read(ROOT / "notebooks" / "02_fundamental_forms.ipynb", as_version=4)
+    for cell in nb.cells:
+        grade_id = cell.metadata.get("nbgrader", {}).get("grade_id")
+        if grade_id == "fundamental_forms":
+            cell.source += "\n\nforms_here = my_fundamental_forms(A_NUM, B_NUM, C_NUM, u, v)   # the lesson's names\n"
+        if grade_id == "normal_curvature":
+            cell.source = "undefined_name\n" + cell.source
+    found = judge.verdicts(nb)
+    assert found["fundamental_forms"]["check"][0] and found["principal_curvatures"]["check"][0]
+    passed, message = found["normal_curvature"]["check"]
+    assert not passed and "solution cell 2 raised NameError: name 'undefined_name' is not defined" in message, message
+    assert "without the lesson's variables" in message
+
+
+@pytest.mark.slow
 def test_each_exercise_is_judged_in_a_fresh_process_of_its_own():
     # the sandboxes of a notebook are forked from one process holding its imports: what one
     # exercise's calls leave behind (here a count on the numpy module) must not reach the next

@@ -24,7 +24,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from geomlib.course.grading import CONFIG_LINE, SET_ASIDE
+from geomlib.course.grading import CONFIG_LINE, MODEL_RUN, SET_ASIDE, SET_ASIDE_AGAIN
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tools"))
@@ -261,18 +261,18 @@ def test_feedback_pages_show_the_judges_verdicts_and_the_students_code_with_the_
         # the rubric and the model answer with the lesson's numbers, from one run of the course's solution
         answers = [c for c, g in zip(code, ids) if g.endswith("_model_answer")]
         assert answers and all(not ran(c) for c in answers)
-        assert all("Rubric (" in "".join(o["data"]["text/markdown"]) for c in answers for o in c["outputs"]), name
-        noted = [
-            c for c in code if any(SET_ASIDE in "".join(o.get("data", {}).get("text/plain", "")) for o in c["outputs"])
-        ]
-        assert len(noted) == 1 and not ran(noted[0])
-        lesson = [c for c in code if not ran(c) and c not in judged + answers and c is not noted[0]]
-        assert lesson and not any(c["outputs"] for c in lesson)
+        for cell in answers:
+            said, *shown = cell["outputs"]
+            assert "".join(said["data"]["text/markdown"]) == MODEL_RUN and shown, name
+            assert all("Rubric (" in "".join(o["data"]["text/markdown"]) for o in shown), name
+        # every cell of the lesson is left unrun and says so, the first at length
+        lesson = [c for c in code if not ran(c) and c not in judged + answers]
+        notes = ["".join(c["outputs"][0]["data"]["text/plain"]) for c in lesson]
+        assert lesson and notes == [SET_ASIDE] + [SET_ASIDE_AGAIN] * (len(lesson) - 1), name
+        assert all(len(c["outputs"]) == 1 for c in lesson)
         page = (course / "feedback" / student / ASSIGNMENT / f"{name}.html").read_text()
         assert "widget-view+json" not in page and "data:image/png;base64," not in page
-        passed = page.count("(decided by the grading judge)")
-        wrong = student == "stubs" or (student == "one_mistake" and name == GRADED["01"])
-        assert passed < len(judged) if wrong else passed == len(judged)
+        assert page.count("(decided by the grading judge)") == len(judged)  # each verdict, passed or failed
         assert (DIAGNOSIS in page) == (student == "one_mistake" and name == GRADED["01"])
         if student == "stubs":
             assert page.count("not written yet") >= 4  # each exercise's two grade cells

@@ -43,9 +43,13 @@ CONFIG_LINE = 'c.Autograde.autograde_preprocessors.insert(0, "geomlib.course.gra
 
 
 SET_ASIDE = (
-    "Not run while grading: nbgrader ran this notebook's first cell, its parameters and your solution "
-    "cells, and the grading judge decided the check cells. The lesson's cells show their output in your own run."
+    "Not run while grading. nbgrader ran only this notebook's first cell, its parameters and your solution cells "
+    "(without the lesson's variables: a solution cell that uses one raises NameError here); the grading judge "
+    "decided the check cells, and each model answer is the course's own run with the default parameters. "
+    "The lesson's cells show their output in your own run."
 )
+SET_ASIDE_AGAIN = "Not run while grading (see the first cell set aside)."
+MODEL_RUN = "*The model answer as the course's solution notebook prints it, with its default parameters:*"
 
 
 class JudgeExercises(NbGraderPreprocessor):
@@ -71,15 +75,15 @@ class JudgeExercises(NbGraderPreprocessor):
             if cell.cell_type != "code":
                 continue
             grade_id = cell.metadata.get("nbgrader", {}).get("grade_id", "")
-            filled = [nbformat.from_dict(o) for o in model[grade_id]] if grade_id in model else _judged(grade_id, found)
+            filled = _model(model[grade_id]) if grade_id in model else _judged(grade_id, found)
             if filled is not None:
                 cell.outputs = filled
             runs = filled is None and (not self.set_aside_lessons or index == first or _kernel_needs(cell))
             tags = [t for t in cell.metadata.get("tags", []) if t != skip] + ([] if runs else [skip])
             if tags or "tags" in cell.metadata:
                 cell.metadata["tags"] = tags
-            if not runs and filled is None and not noted:
-                cell.outputs, noted = [nbformat.v4.new_output("display_data", data={"text/plain": SET_ASIDE})], True
+            if not runs and filled is None:
+                cell.outputs, noted = [_note(SET_ASIDE_AGAIN if noted else SET_ASIDE)], True
         nb.metadata.setdefault("geomlib", {})["grading"] = found
         return nb, resources
 
@@ -92,6 +96,16 @@ class JudgeExercises(NbGraderPreprocessor):
             f"{info.get('notebook', '')}.ipynb",
         )
         return path if os.path.exists(path) else None
+
+
+def _note(text):
+    return nbformat.v4.new_output("display_data", data={"text/markdown": f"*{text}*", "text/plain": text})
+
+
+def _model(outputs):
+    """A model-answer cell's outputs from the course's run, under a line saying where they come from."""
+    said = nbformat.v4.new_output("display_data", data={"text/markdown": MODEL_RUN, "text/plain": MODEL_RUN.strip("*")})
+    return [said, *(nbformat.from_dict(o) for o in outputs)]
 
 
 def _judged(grade_id, found):
@@ -121,6 +135,7 @@ def _outputs(passed, message, flags):
             evalue=message,
             traceback=[
                 *CheckFailed(message)._render_traceback_(),
+                "(decided by the grading judge)",
                 *([flagged] if flagged else []),
             ],  # as the kernel shows it
         )

@@ -284,16 +284,20 @@ def run(plan, reply):
         send(reply, {"raised": type(exc).__name__, "message": str(exc), "stub": False, "setup": True})
         os._exit(0)
     _arm(ns, plan["allow"], fatal, cells)
-    try:
-        for code in cells:
+    raised = []  # as in a kernel: a cell that raises stops there, and the next cell still runs
+    for i, code in enumerate(cells):
+        try:
             exec(code, ns)
+        except BaseException as exc:  # noqa: BLE001 - the student's cells may raise anything
+            raised.append(f"solution cell {i + 1} raised {type(exc).__name__}: {str(exc)[:300]}")
+    try:
         for name, (kind, target) in plan["bindings"].items():
             ns[name] = ns[target] if kind == "student" else _reference(ns, target)
-    except BaseException as exc:  # noqa: BLE001 - the student's cells may raise anything
+    except BaseException as exc:  # noqa: BLE001 - a use cell names a function no cell defined
         send(reply, {"raised": type(exc).__name__, "message": str(exc)[:500], "stub": False, "setup": True})
         os._exit(0)
     send(reply, {"ready": True})
-    serve(ns, reply)
+    serve(ns, reply, raised)
 
 
 def _callback(reply):
@@ -312,7 +316,8 @@ def _callback(reply):
     return make
 
 
-def serve(ns, reply):
+def serve(ns, reply, raised=()):
+    """Answer the judge's calls of the student's functions; ``raised`` says which solution cells raised."""
     callback = _callback(reply)
     while True:
         request = receive(0)
@@ -321,7 +326,8 @@ def serve(ns, reply):
         args = [decode(a, callback) for a in request["args"]]
         try:
             if request["call"] not in ns:
-                raise NameError(f"the solution cells define no `{request['call']}`")
+                why = f" ({'; '.join(raised)}: grading runs them without the lesson's variables)" if raised else ""
+                raise NameError(f"the solution cells define no `{request['call']}`{why}")
             out = ns[request["call"]](*args)
             answer = {"ok": encode(out), "args": [encode(a) for a in args]}
         except BaseException as exc:  # noqa: BLE001 - the student's function may raise anything
