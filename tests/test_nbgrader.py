@@ -276,8 +276,9 @@ def test_feedback_pages_show_the_judges_verdicts_and_the_students_code_with_the_
         assert (DIAGNOSIS in page) == (student == "one_mistake" and name == GRADED["01"])
         if student == "stubs":
             assert page.count("not written yet") >= 4  # each exercise's two grade cells
-        # the model answer the release hid, put back: its rubric and its prose, not only numbers
+        # the model answer the release hid, put back: its rubric and its prose, not only numbers, once
         assert "Rubric (" in page and "Model answer" in page, name
+        assert "BEGIN HIDDEN TESTS" not in page and page.count("Rubric (") == len(answers), name
 
 
 @pytest.mark.slow

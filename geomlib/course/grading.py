@@ -78,6 +78,8 @@ class JudgeExercises(NbGraderPreprocessor):
             filled = _model(model[grade_id]) if grade_id in model else _judged(grade_id, found)
             if filled is not None:
                 cell.outputs = filled
+            if grade_id in model:  # the feedback page shows the rubric once, as its output, not its source too
+                cell.metadata["transient"] = {"remove_source": True}
             runs = filled is None and (not self.set_aside_lessons or index == first or _kernel_needs(cell))
             tags = [t for t in cell.metadata.get("tags", []) if t != skip] + ([] if runs else [skip])
             if tags or "tags" in cell.metadata:
