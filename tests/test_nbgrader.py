@@ -309,3 +309,28 @@ def test_the_assignment_build_is_an_nbgrader_release_like_generate_assignments(c
         assert [{k: c.metadata.get("nbgrader", {}).get(k) for k in keys} for c in ours.cells] == [
             {k: c.metadata.get("nbgrader", {}).get(k) for k in keys} for c in theirs.cells
         ]
+
+
+@pytest.mark.parametrize("set_aside", (True, False))
+def test_the_judge_tags_what_the_kernel_skips_and_untags_what_it_must_run(set_aside):
+    from traitlets.config import Config
+
+    from geomlib.course.grading import JudgeExercises
+
+    nb = nbformat.read(ROOT / "notebooks" / "05_explicit_smoothing.ipynb", as_version=4)
+    solution = next(c for c in nb.cells if c.metadata.get("nbgrader", {}).get("grade_id") == "lam_max")
+    solution.metadata["tags"] = ["skip-execution"]  # a student's tag, to keep a cell from nbgrader's run
+    config = Config({"JudgeExercises": {"set_aside_lessons": set_aside}})
+    resources = {"nbgrader": {"notebook": "none", "assignment": "none"}}  # no source folder: no model answers
+    nb, resources = JudgeExercises(config=config).preprocess(nb, resources)
+    assert JudgeExercises(config=config).preprocess(nb, resources)[0] is nb  # judged once per conversion
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    skipped = ["skip-execution" in c.metadata.get("tags", []) for c in code]
+    for i, (cell, skip) in enumerate(zip(code, skipped)):
+        info = cell.metadata.get("nbgrader", {})
+        judged = info.get("grade_id", "").endswith(("_check", "_partial_credit"))
+        kernel = i == 0 or "parameters" in cell.metadata.get("tags", []) or info.get("solution")
+        assert skip == (judged or (set_aside and not kernel)), cell.source[:80]
+        assert bool(cell.outputs) == (judged or (set_aside and skip)), cell.source[:80]
+    assert not solution.metadata["tags"]
+    assert set(nb.metadata["geomlib"]["grading"]) == {"lam_max", "smoothing_loop"}
